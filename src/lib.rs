@@ -1,0 +1,16 @@
+//! psa-esp: evolving neural controllers for the Personal Satellite Assistant
+//! (PSA), replicating Høverstad, "Revisiting the Personal Satellite
+//! Assistant" (GECCO 2007).
+//!
+//! Layers, each depending only on those before it:
+//! 1. `ode-sys` (a separate crate): raw bindgen bindings to libode;
+//! 2. [`ode`]: the safe ODE wrapper (all of the project's other `unsafe`);
+//! 3. [`physics`]: the backends `ode`, `native` and `rapier` behind one trait;
+//! 4. [`psa`]: the robot, its thrusters and (later) its tasks;
+//! 5. [`provenance`] and the command-line tools in [`cli`].
+
+pub mod cli;
+pub mod ode;
+pub mod physics;
+pub mod provenance;
+pub mod psa;

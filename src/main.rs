@@ -1,0 +1,3 @@
+fn main() {
+    println!("{:?}", psa_esp::provenance::build_info());
+}

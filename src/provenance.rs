@@ -1,0 +1,24 @@
+//! Where a result came from: tool version, git commit and libode version,
+//! stamped into the binary by `build.rs`.
+
+use serde::Serialize;
+
+/// The build's identity, recorded in every result file.
+#[derive(Debug, Clone, Serialize)]
+pub struct BuildInfo {
+    /// The crate version.
+    pub tool_version: &'static str,
+    /// The git commit of the build (`-dirty` when it had uncommitted changes).
+    pub git_commit: &'static str,
+    /// The libode version `ode-sys` was built against.
+    pub libode_version: &'static str,
+}
+
+/// This binary's build identity.
+pub fn build_info() -> BuildInfo {
+    BuildInfo {
+        tool_version: env!("CARGO_PKG_VERSION"),
+        git_commit: env!("PSA_ESP_GIT_COMMIT"),
+        libode_version: env!("PSA_ESP_LIBODE_VERSION"),
+    }
+}
