@@ -56,8 +56,9 @@ fn main() {
         });
     }
     // bindgen panics when it cannot load libclang: turn that into a message.
-    let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || builder.generate()))
-        .unwrap_or_else(|_| Err(bindgen::BindgenError::NotExist(PathBuf::from("libclang"))));
+    let generated =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || builder.generate()))
+            .unwrap_or_else(|_| Err(bindgen::BindgenError::NotExist(PathBuf::from("libclang"))));
     let bindings = match generated {
         Ok(b) => b,
         Err(err) => {

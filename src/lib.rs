@@ -10,6 +10,7 @@
 //! 5. [`provenance`] and the command-line tools in [`cli`].
 
 pub mod cli;
+pub mod io;
 pub mod ode;
 pub mod physics;
 pub mod provenance;

@@ -1,1 +1,74 @@
-//! Command-line tools.
+//! The `psa-esp` command line (clap).
+
+mod bench;
+mod crosscheck;
+mod simulate;
+
+use clap::{Parser, Subcommand};
+
+/// The exit code of a run whose checks failed (a cross-check out of tolerance).
+pub const EXIT_CHECK_FAILED: i32 = 1;
+/// The exit code of a run stopped by bad input or an I/O error.
+pub const EXIT_ERROR: i32 = 2;
+
+/// Evolving neural controllers for the Personal Satellite Assistant.
+#[derive(Debug, Parser)]
+#[command(name = "psa-esp", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate the PSA under given thrust and write its trajectory as CSV.
+    Simulate(simulate::SimulateArgs),
+    /// Run random thrust sequences on every backend and compare each with ODE.
+    Crosscheck(crosscheck::CrosscheckArgs),
+    /// Measure ns per physics step of every backend in one run.
+    Bench(bench::BenchArgs),
+}
+
+/// Runs a parsed command line; `Ok(code)` is the process exit code.
+pub fn run(cli: Cli) -> anyhow::Result<i32> {
+    match cli.command {
+        Command::Simulate(args) => simulate::run(args),
+        Command::Crosscheck(args) => crosscheck::run(args),
+        Command::Bench(args) => bench::run(args),
+    }
+}
+
+/// Physics options shared by the subcommands that simulate.
+#[derive(Debug, Clone, clap::Args)]
+pub struct PhysicsArgs {
+    /// Time step (s).
+    #[arg(long, default_value_t = crate::physics::StepSettings::default().dt, allow_negative_numbers = true)]
+    pub dt: f64,
+    /// ODE stepper: exact (dWorldStep) or quick (dWorldQuickStep).
+    #[arg(long, value_parser = ["exact", "quick"], default_value = "exact")]
+    pub stepper: String,
+    /// How ODE keeps the body in the plane: none or plane2d (a Plane2D joint).
+    #[arg(long, value_parser = ["none", "plane2d"], default_value = "none")]
+    pub plane: String,
+}
+
+impl PhysicsArgs {
+    /// The step settings these options describe.
+    pub fn settings(&self) -> anyhow::Result<crate::physics::StepSettings> {
+        use crate::physics::{PlaneConstraint, StepSettings, Stepper};
+        let settings = StepSettings {
+            dt: self.dt,
+            stepper: if self.stepper == "quick" { Stepper::Quick } else { Stepper::Exact },
+            plane_constraint: if self.plane == "plane2d" {
+                PlaneConstraint::Plane2dJoint
+            } else {
+                PlaneConstraint::None
+            },
+            ..StepSettings::default()
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+}

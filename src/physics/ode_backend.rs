@@ -58,6 +58,7 @@ impl OdeBackend {
         mass.translate([-center[0], -center[1], -center[2]])?;
         let body = world.create_body()?;
         body.set_mass(&mass)?;
+        body.set_gyroscopic_mode(settings.ode_gyroscopic);
         let stored = body.mass();
         let properties = MassProperties {
             mass: stored.total(),

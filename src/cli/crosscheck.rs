@@ -1,0 +1,59 @@
+//! `psa-esp crosscheck`: every backend against ODE on random thrust sequences.
+
+use anyhow::Result;
+
+use super::{PhysicsArgs, EXIT_CHECK_FAILED};
+use crate::physics::crosscheck;
+use crate::psa::BodySettings;
+
+/// Arguments of `crosscheck`.
+#[derive(Debug, clap::Args)]
+pub struct CrosscheckArgs {
+    /// Number of random thrust sequences.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
+    pub sequences: u64,
+    /// Steps per sequence.
+    #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u64).range(1..))]
+    pub steps: u64,
+    /// Seed of the thrust sequences.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub physics: PhysicsArgs,
+}
+
+/// Runs `crosscheck`; exits with [`EXIT_CHECK_FAILED`] when a backend is out of tolerance.
+pub fn run(args: CrosscheckArgs) -> Result<i32> {
+    let settings = args.physics.settings()?;
+    let model = BodySettings::default().model()?;
+    let report = crosscheck(&model, &settings, args.sequences as usize, args.steps as usize, args.seed)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "{} random thrust sequences x {} steps (seed {}), largest difference against ode:",
+            report.sequences, report.steps, report.seed
+        );
+        println!(
+            "{:<8} {:>12} {:>12} {:>12}   {:>12} {:>12} {:>12}  result",
+            "backend", "position/m", "heading/rad", "velocity", "tol pos", "tol head", "tol vel"
+        );
+        for c in &report.comparisons {
+            println!(
+                "{:<8} {:>12.3e} {:>12.3e} {:>12.3e}   {:>12.1e} {:>12.1e} {:>12.1e}  {}",
+                c.backend.name(),
+                c.deviation.position,
+                c.deviation.heading,
+                c.deviation.velocity,
+                c.tolerance.position,
+                c.tolerance.heading,
+                c.tolerance.velocity,
+                if c.passed { "ok" } else { "OUT OF TOLERANCE" }
+            );
+        }
+    }
+    Ok(if report.passed() { 0 } else { EXIT_CHECK_FAILED })
+}

@@ -1,0 +1,97 @@
+//! Backends against each other on seeded random thrust sequences.
+
+use psa_esp::physics::{
+    create_backend, crosscheck, random_thrust_sequence, tolerance, trajectory, BackendKind,
+    BodyState, Deviation, PlaneConstraint, StepSettings, Stepper,
+};
+use psa_esp::psa::BodySettings;
+
+#[test]
+fn native_matches_ode_within_1e_9_on_100_random_sequences() {
+    let model = BodySettings::default().model().unwrap();
+    let report = crosscheck(&model, &StepSettings::default(), 100, 500, 7).unwrap();
+    let native = report
+        .comparisons
+        .iter()
+        .find(|c| c.backend == BackendKind::Native)
+        .unwrap();
+    assert!(native.deviation.position <= 1e-9, "{:?}", native.deviation);
+    assert!(native.deviation.heading <= 1e-9, "{:?}", native.deviation);
+    assert!(native.deviation.velocity <= 1e-9, "{:?}", native.deviation);
+    assert!(native.passed);
+    // The sequences really move the body: a do-nothing backend would fail.
+    let commands = random_thrust_sequence(7, 0, 500, 4);
+    let mut ode = create_backend(BackendKind::Ode, &model, &StepSettings::default()).unwrap();
+    let end = *trajectory(ode.as_mut(), &BodyState::default(), &commands)
+        .unwrap()
+        .last()
+        .unwrap();
+    assert!(end.x.hypot(end.y) > 0.1 && end.omega.abs() > 0.1, "{end:?}");
+}
+
+#[cfg(feature = "rapier")]
+#[test]
+fn rapier_agrees_with_ode_within_its_stated_tolerance() {
+    let model = BodySettings::default().model().unwrap();
+    let report = crosscheck(&model, &StepSettings::default(), 100, 500, 11).unwrap();
+    let rapier = report
+        .comparisons
+        .iter()
+        .find(|c| c.backend == BackendKind::Rapier)
+        .unwrap();
+    assert_eq!(rapier.tolerance, tolerance(BackendKind::Rapier));
+    assert!(
+        rapier.passed,
+        "{:?} exceeds {:?}",
+        rapier.deviation, rapier.tolerance
+    );
+}
+
+fn max_deviation(a: StepSettings, b: StepSettings, sequences: u64) -> (Deviation, bool) {
+    let model = BodySettings::default().model().unwrap();
+    let mut x = create_backend(BackendKind::Ode, &model, &a).unwrap();
+    let mut y = create_backend(BackendKind::Ode, &model, &b).unwrap();
+    let start = BodyState {
+        omega: 0.5,
+        vy: 0.1,
+        ..BodyState::default()
+    };
+    let mut worst = Deviation::between(&start, &start);
+    let mut identical = true;
+    for i in 0..sequences {
+        let commands = random_thrust_sequence(3, i, 500, 4);
+        let tx = trajectory(x.as_mut(), &start, &commands).unwrap();
+        let ty = trajectory(y.as_mut(), &start, &commands).unwrap();
+        identical &= tx == ty;
+        for (p, q) in tx.iter().zip(&ty) {
+            worst = worst.max(Deviation::between(p, q));
+        }
+    }
+    (worst, identical)
+}
+
+#[test]
+fn plane2d_joint_and_no_joint_give_identical_trajectories() {
+    // Why no joint is the default: with every force in the mid-plane the
+    // body never leaves the plane, and the joint's constraint forces are
+    // exactly zero, so the trajectories are bit-identical.
+    let free = StepSettings::default();
+    assert_eq!(free.plane_constraint, PlaneConstraint::None);
+    let joint = StepSettings {
+        plane_constraint: PlaneConstraint::Plane2dJoint,
+        ..free
+    };
+    let (worst, identical) = max_deviation(free, joint, 50);
+    assert!(identical, "trajectories differ by {worst:?}");
+}
+
+#[test]
+fn quick_step_agrees_with_the_exact_stepper() {
+    let exact = StepSettings::default();
+    let quick = StepSettings {
+        stepper: Stepper::Quick,
+        ..exact
+    };
+    let (worst, _) = max_deviation(exact, quick, 10);
+    assert!(worst.within(&tolerance(BackendKind::Native)), "{worst:?}");
+}

@@ -1,0 +1,137 @@
+//! The command line end to end.
+
+use std::process::{Command, Output};
+
+fn psa_esp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_psa-esp"))
+        .args(args)
+        .output()
+        .expect("run psa-esp")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn simulate_writes_the_trajectory_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("traj.csv");
+    for backend in ["ode", "native"] {
+        let o = psa_esp(&[
+            "simulate",
+            "--backend",
+            backend,
+            "--thrust",
+            "1,0,1,0",
+            "--steps",
+            "40",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let csv = std::fs::read_to_string(&out).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "t,x,y,heading,vx,vy,omega");
+        assert_eq!(lines.len(), 42, "header + start + 40 steps");
+        let last: Vec<f64> = lines[41].split(',').map(|v| v.parse().unwrap()).collect();
+        assert!(
+            (last[0] - 2.0).abs() < 1e-12 && last[1] > 0.0 && last[2] == 0.0 && last[6] == 0.0,
+            "{last:?}"
+        );
+    }
+}
+
+#[test]
+fn simulate_reads_a_thrust_file_and_prints_to_stdout() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("thrust.txt");
+    std::fs::write(&file, "# u0 u1 u2 u3\n1 0 0 0\n1,0,0,0\n0 0 0 0\n").unwrap();
+    let o = psa_esp(&[
+        "simulate",
+        "--thrust-file",
+        file.to_str().unwrap(),
+        "--start",
+        "0,0,0,0,0.1,0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 4);
+    assert!(
+        rows[3][6] > 0.0,
+        "thruster 0 spins the body anticlockwise: {rows:?}"
+    );
+    assert!(
+        rows[3][2] > 0.0,
+        "the start velocity 0.1 m/s along y carries it: {rows:?}"
+    );
+}
+
+#[test]
+fn bad_arguments_get_a_clear_error_and_a_nonzero_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad_file = dir.path().join("bad.txt");
+    std::fs::write(&bad_file, "1 0 0\n").unwrap();
+    let bad_file = bad_file.to_str().unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (&["simulate", "--thrust", "nan,0,0,0"], "NaN"),
+        (&["simulate", "--thrust", "0,2,0,0"], "thruster 1: 2"),
+        (&["simulate", "--thrust", "0,0,0"], "4 comma-separated"),
+        (&["simulate", "--thrust", "0,0,0,0", "--dt", "-1"], "dt"),
+        (
+            &["simulate", "--thrust-file", bad_file],
+            "line 1: expected 4",
+        ),
+        (
+            &["simulate", "--thrust-file", "/nonexistent/thrust.txt"],
+            "/nonexistent/thrust.txt",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = psa_esp(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("panicked"), "{args:?}");
+    }
+    let o = psa_esp(&["simulate", "--backend", "bullet", "--thrust", "0,0,0,0"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("bullet"));
+}
+
+#[test]
+fn crosscheck_reports_every_backend_against_ode() {
+    let o = psa_esp(&["crosscheck", "--sequences", "5", "--steps", "200", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let comparisons = report["comparisons"].as_array().unwrap();
+    let expected = if cfg!(feature = "rapier") { 2 } else { 1 };
+    assert_eq!(comparisons.len(), expected);
+    for c in comparisons {
+        assert_eq!(c["passed"], true, "{c}");
+        assert!(c["deviation"]["position"].as_f64().unwrap() >= 0.0);
+    }
+    let o = psa_esp(&["crosscheck", "--sequences", "2", "--steps", "50"]);
+    assert!(o.status.success());
+    assert!(stdout(&o).contains("native"), "{}", stdout(&o));
+}
+
+#[test]
+fn bench_prints_ns_per_step_for_every_backend() {
+    let o = psa_esp(&["bench", "--steps", "1000", "--rounds", "1", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let rows = report["physics_step"].as_array().unwrap();
+    assert_eq!(rows.len(), psa_esp::physics::BackendKind::available().len());
+    assert!(rows
+        .iter()
+        .all(|r| r["median_ns_per_step"].as_f64().unwrap() > 0.0));
+}
