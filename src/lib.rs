@@ -11,7 +11,9 @@
 
 pub mod cli;
 pub mod io;
+pub mod network;
 pub mod ode;
 pub mod physics;
 pub mod provenance;
 pub mod psa;
+pub mod rng;

@@ -22,3 +22,8 @@ pub fn build_info() -> BuildInfo {
         libode_version: env!("PSA_ESP_LIBODE_VERSION"),
     }
 }
+
+/// The current UTC time as RFC 3339, to the second.
+pub fn now_rfc3339() -> String {
+    humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
+}

@@ -1,5 +1,17 @@
-//! The Personal Satellite Assistant: its body and thrusters.
+//! The Personal Satellite Assistant as a control problem: its body and
+//! thrusters, sensors and noise, the paper's three tasks, both fitness
+//! functions, trials, and the network file format.
 
 pub mod body;
+pub mod fitness;
+pub mod network_file;
+pub mod sensors;
+pub mod task;
+pub mod trial;
 
 pub use body::{BodySettings, THRUSTER_COUNT};
+pub use fitness::{FitnessKind, FitnessSettings};
+pub use network_file::{NetworkFile, NetworkFileError};
+pub use sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
+pub use task::{Target, Task, TaskSettings};
+pub use trial::{PsaError, PsaSettings, TrialRecord, TrialRunner};

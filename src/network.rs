@@ -1,0 +1,195 @@
+//! The controller: a feed-forward network with one hidden layer of logistic
+//! units, stored neuron-wise as ESP needs it.
+//!
+//! Each hidden neuron owns `inputs` input weights (the bias input included)
+//! followed by `outputs` output weights: `inputs + outputs` genes (11 for the
+//! PSA's 7-H-4 network). Outputs are logistic too, with no separate bias.
+//! A lesioned hidden neuron contributes nothing to the outputs.
+
+use thiserror::Error;
+
+/// Errors building a network.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum NetworkError {
+    /// A size is zero or the genes do not fit the sizes.
+    #[error("network shape: {0}")]
+    Shape(String),
+    /// A weight is NaN or infinite.
+    #[error("weight {index} of hidden neuron {neuron} is not finite ({value})")]
+    NonFinite {
+        /// Hidden neuron.
+        neuron: usize,
+        /// Gene index within the neuron.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+}
+
+/// The logistic sigmoid 1 / (1 + e^-x).
+#[inline]
+pub fn sigmoid(x: f64) -> f64 {
+    1.0 / (1.0 + (-x).exp())
+}
+
+fn check_sizes(inputs: usize, outputs: usize) -> Result<(), NetworkError> {
+    if inputs == 0 || outputs == 0 {
+        return Err(NetworkError::Shape(format!(
+            "inputs and outputs must be >= 1, got {inputs} and {outputs}"
+        )));
+    }
+    Ok(())
+}
+
+/// A 1-hidden-layer network; see the module docs for the gene layout.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Network {
+    inputs: usize,
+    outputs: usize,
+    genes: Vec<f64>,
+    lesioned: Vec<bool>,
+}
+
+impl Network {
+    /// A network from its hidden neurons' genes, one `Vec` per neuron.
+    pub fn from_neurons(inputs: usize, outputs: usize, neurons: &[Vec<f64>]) -> Result<Network, NetworkError> {
+        check_sizes(inputs, outputs)?;
+        if let Some((k, n)) = neurons.iter().enumerate().find(|(_, n)| n.len() != inputs + outputs) {
+            return Err(NetworkError::Shape(format!(
+                "hidden neuron {k} has {} weights, expected {} ({inputs} inputs + {outputs} outputs)",
+                n.len(),
+                inputs + outputs
+            )));
+        }
+        Network::from_genes(inputs, outputs, neurons.concat())
+    }
+
+    /// A network from all genes laid out neuron after neuron.
+    pub fn from_genes(inputs: usize, outputs: usize, genes: Vec<f64>) -> Result<Network, NetworkError> {
+        check_sizes(inputs, outputs)?;
+        let per = inputs + outputs;
+        if genes.is_empty() || genes.len() % per != 0 {
+            return Err(NetworkError::Shape(format!(
+                "{} weights do not make whole hidden neurons of {per} weights (at least one neuron)",
+                genes.len()
+            )));
+        }
+        if let Some((i, &value)) = genes.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(NetworkError::NonFinite {
+                neuron: i / per,
+                index: i % per,
+                value,
+            });
+        }
+        let hidden = genes.len() / per;
+        Ok(Network {
+            inputs,
+            outputs,
+            genes,
+            lesioned: vec![false; hidden],
+        })
+    }
+
+    /// Number of inputs (the bias input included).
+    pub fn inputs(&self) -> usize {
+        self.inputs
+    }
+
+    /// Number of outputs.
+    pub fn outputs(&self) -> usize {
+        self.outputs
+    }
+
+    /// Number of hidden neurons.
+    pub fn hidden(&self) -> usize {
+        self.lesioned.len()
+    }
+
+    /// Genes per hidden neuron: inputs + outputs.
+    pub fn genes_per_neuron(&self) -> usize {
+        self.inputs + self.outputs
+    }
+
+    /// All genes, neuron after neuron.
+    pub fn genes(&self) -> &[f64] {
+        &self.genes
+    }
+
+    /// The genes of hidden neuron `k`: input weights, then output weights.
+    pub fn neuron(&self, k: usize) -> &[f64] {
+        let per = self.genes_per_neuron();
+        &self.genes[k * per..(k + 1) * per]
+    }
+
+    /// Switches hidden neuron `k` off (`true`) or on.
+    pub fn set_lesioned(&mut self, k: usize, lesioned: bool) {
+        self.lesioned[k] = lesioned;
+    }
+
+    /// Whether hidden neuron `k` is switched off.
+    pub fn is_lesioned(&self, k: usize) -> bool {
+        self.lesioned[k]
+    }
+
+    /// Computes the outputs for `input` into `output`; allocates nothing.
+    ///
+    /// # Panics
+    /// If the slices' lengths differ from the network's inputs and outputs.
+    pub fn activate(&self, input: &[f64], output: &mut [f64]) {
+        assert_eq!(input.len(), self.inputs, "input length");
+        assert_eq!(output.len(), self.outputs, "output length");
+        output.fill(0.0);
+        let per = self.genes_per_neuron();
+        for (neuron, &lesioned) in self.genes.chunks_exact(per).zip(&self.lesioned) {
+            if lesioned {
+                continue;
+            }
+            let (w_in, w_out) = neuron.split_at(self.inputs);
+            let activation: f64 = w_in.iter().zip(input).map(|(w, x)| w * x).sum();
+            let h = sigmoid(activation);
+            for (o, w) in output.iter_mut().zip(w_out) {
+                *o += h * w;
+            }
+        }
+        for o in output.iter_mut() {
+            *o = sigmoid(*o);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn activation_matches_a_hand_computation() {
+        // 2 inputs (x, bias), 1 output, 2 hidden neurons.
+        let net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
+        let mut out = [0.0];
+        net.activate(&[2.0, 1.0], &mut out);
+        let expected = sigmoid(2.0 * sigmoid(1.0) - 3.0 * sigmoid(1.0));
+        assert_eq!(out[0], expected);
+    }
+
+    #[test]
+    fn a_lesioned_neuron_contributes_nothing() {
+        let mut net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
+        net.set_lesioned(1, true);
+        let mut out = [0.0];
+        net.activate(&[2.0, 1.0], &mut out);
+        assert_eq!(out[0], sigmoid(2.0 * sigmoid(1.0)));
+        let alone = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0]]).unwrap();
+        let mut out2 = [0.0];
+        alone.activate(&[2.0, 1.0], &mut out2);
+        assert_eq!(out, out2);
+    }
+
+    #[test]
+    fn bad_shapes_and_weights_are_refused() {
+        assert!(Network::from_genes(7, 4, vec![]).is_err());
+        assert!(Network::from_genes(7, 4, vec![0.0; 12]).is_err());
+        assert!(Network::from_neurons(7, 4, &[vec![0.0; 11], vec![0.0; 10]]).is_err());
+        let err = Network::from_genes(7, 4, [vec![0.0; 13], vec![f64::NAN], vec![0.0; 8]].concat()).unwrap_err();
+        assert_eq!(err.to_string(), "weight 2 of hidden neuron 1 is not finite (NaN)");
+    }
+}

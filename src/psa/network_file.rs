@@ -1,0 +1,181 @@
+//! The network file: a versioned JSON document holding a controller's
+//! topology, weights, activation, input scaling, the task it was evolved
+//! for and its provenance. Saving and loading round-trips exactly.
+//!
+//! ```json
+//! {
+//!   "format": "psa-esp-network",
+//!   "version": 1,
+//!   "topology": { "inputs": 7, "hidden": 5, "outputs": 4 },
+//!   "activation": "logistic",
+//!   "input_scaling": { "position_scale": 10.0, ... },
+//!   "task": 1,
+//!   "neurons": [ { "weights": [11 numbers: 7 input weights (bias last), 4 output weights], "lesioned": false }, ... ],
+//!   "provenance": { "tool_version": "...", "git_commit": "...", "libode_version": "...", "created": "...", ... }
+//! }
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::sensors::SensorSettings;
+use super::task::Task;
+use crate::network::Network;
+
+/// The `format` field of every network file.
+pub const FORMAT: &str = "psa-esp-network";
+/// The version this build writes and reads.
+pub const VERSION: u32 = 1;
+/// The only activation function.
+pub const ACTIVATION: &str = "logistic";
+
+/// Why a network file could not be read or written; always names the file.
+#[derive(Debug, Error)]
+#[error("network file {}: {problem}", path.display())]
+pub struct NetworkFileError {
+    /// The file.
+    pub path: PathBuf,
+    /// What is wrong with it.
+    pub problem: String,
+}
+
+/// Sizes of the network.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Topology {
+    /// Inputs, bias included.
+    pub inputs: usize,
+    /// Hidden neurons.
+    pub hidden: usize,
+    /// Outputs.
+    pub outputs: usize,
+}
+
+/// One hidden neuron.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NeuronRecord {
+    /// Input weights (bias weight last), then output weights.
+    pub weights: Vec<f64>,
+    /// Whether the neuron is switched off.
+    #[serde(default)]
+    pub lesioned: bool,
+}
+
+/// The whole file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NetworkFile {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// Always [`VERSION`] for this build.
+    pub version: u32,
+    /// Sizes.
+    pub topology: Topology,
+    /// Always [`ACTIVATION`].
+    pub activation: String,
+    /// The input scaling the network was evolved with.
+    pub input_scaling: SensorSettings,
+    /// The task it was evolved for.
+    pub task: Task,
+    /// The hidden neurons.
+    pub neurons: Vec<NeuronRecord>,
+    /// Where it came from: the build, the time, and any further fields
+    /// (seed, configuration, fitness) the writer adds.
+    pub provenance: serde_json::Map<String, serde_json::Value>,
+}
+
+impl NetworkFile {
+    /// A file for `network`, stamped with this build and the current time;
+    /// `extra` adds provenance fields.
+    pub fn new(
+        network: &Network,
+        task: Task,
+        input_scaling: SensorSettings,
+        extra: serde_json::Map<String, serde_json::Value>,
+    ) -> NetworkFile {
+        let build = crate::provenance::build_info();
+        let mut provenance = serde_json::Map::new();
+        provenance.insert("tool_version".into(), build.tool_version.into());
+        provenance.insert("git_commit".into(), build.git_commit.into());
+        provenance.insert("libode_version".into(), build.libode_version.into());
+        provenance.insert("created".into(), crate::provenance::now_rfc3339().into());
+        provenance.extend(extra);
+        NetworkFile {
+            format: FORMAT.into(),
+            version: VERSION,
+            topology: Topology {
+                inputs: network.inputs(),
+                hidden: network.hidden(),
+                outputs: network.outputs(),
+            },
+            activation: ACTIVATION.into(),
+            input_scaling,
+            task,
+            neurons: (0..network.hidden())
+                .map(|k| NeuronRecord {
+                    weights: network.neuron(k).to_vec(),
+                    lesioned: network.is_lesioned(k),
+                })
+                .collect(),
+            provenance,
+        }
+    }
+
+    /// The network this file describes, after checking every size and weight.
+    pub fn network(&self) -> Result<Network, String> {
+        let t = self.topology;
+        if self.neurons.len() != t.hidden {
+            return Err(format!("topology says {} hidden neurons, the file has {}", t.hidden, self.neurons.len()));
+        }
+        let weights: Vec<Vec<f64>> = self.neurons.iter().map(|n| n.weights.clone()).collect();
+        let mut network = Network::from_neurons(t.inputs, t.outputs, &weights).map_err(|e| e.to_string())?;
+        for (k, n) in self.neurons.iter().enumerate() {
+            network.set_lesioned(k, n.lesioned);
+        }
+        Ok(network)
+    }
+
+    /// Writes the file atomically as pretty JSON.
+    pub fn save(&self, path: &Path) -> Result<(), NetworkFileError> {
+        let fail = |problem: String| NetworkFileError {
+            path: path.to_path_buf(),
+            problem,
+        };
+        let mut json = serde_json::to_string_pretty(self).map_err(|e| fail(e.to_string()))?;
+        json.push('\n');
+        crate::io::write_atomic(path, json.as_bytes()).map_err(|e| fail(format!("{e:#}")))
+    }
+
+    /// Reads and checks a file: JSON, format, version, activation, sizes,
+    /// finite weights. Returns the file and its network.
+    pub fn load(path: &Path) -> Result<(NetworkFile, Network), NetworkFileError> {
+        let fail = |problem: String| NetworkFileError {
+            path: path.to_path_buf(),
+            problem,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read it: {e}")))?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| fail(format!("not valid JSON: {e}")))?;
+        match value.get("format").and_then(|f| f.as_str()) {
+            Some(FORMAT) => {}
+            Some(other) => return Err(fail(format!("format is {other:?}, expected {FORMAT:?}"))),
+            None => return Err(fail(format!("no \"format\": {FORMAT:?} field; not a psa-esp network file"))),
+        }
+        match value.get("version").and_then(|v| v.as_u64()) {
+            Some(v) if v == VERSION as u64 => {}
+            Some(v) => {
+                return Err(fail(format!("unknown version {v}; this build reads version {VERSION}")));
+            }
+            None => return Err(fail("no numeric \"version\" field".into())),
+        }
+        let file: NetworkFile = serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;
+        if file.activation != ACTIVATION {
+            return Err(fail(format!("activation {:?} is not supported (only {ACTIVATION:?})", file.activation)));
+        }
+        let network = file.network().map_err(fail)?;
+        Ok((file, network))
+    }
+}

@@ -1,0 +1,116 @@
+//! What the controller sees and how its outputs reach the thrusters
+//! (`psa-model.md` §2): inputs relative to the target in the world frame,
+//! scaled, with Gaussian noise on inputs and outputs.
+
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use super::task::Target;
+use crate::physics::{wrap_angle, BodyState};
+
+/// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
+pub const INPUT_COUNT: usize = 7;
+
+/// Input scaling ([chosen] values; the paper's inputs were O(1) or larger).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorSettings {
+    /// Input units per metre of position relative to the target. [chosen] 10
+    pub position_scale: f64,
+    /// Input units per m/s of velocity. [chosen] 10
+    pub velocity_scale: f64,
+    /// Input units per radian of heading error. [chosen] 1
+    pub heading_scale: f64,
+    /// Input units per rad/s of angular velocity. [chosen] 1
+    pub angular_velocity_scale: f64,
+    /// The constant bias input. [chosen] 1
+    pub bias: f64,
+}
+
+impl Default for SensorSettings {
+    fn default() -> Self {
+        SensorSettings {
+            position_scale: 10.0,
+            velocity_scale: 10.0,
+            heading_scale: 1.0,
+            angular_velocity_scale: 1.0,
+            bias: 1.0,
+        }
+    }
+}
+
+impl SensorSettings {
+    /// The network inputs for `state` relative to `target`, without noise:
+    /// x, y, vx, vy, heading error wrapped to (-pi, pi], omega, bias.
+    pub fn inputs(&self, state: &BodyState, target: &Target) -> [f64; INPUT_COUNT] {
+        [
+            (state.x - target.x) * self.position_scale,
+            (state.y - target.y) * self.position_scale,
+            state.vx * self.velocity_scale,
+            state.vy * self.velocity_scale,
+            wrap_angle(state.heading - target.heading) * self.heading_scale,
+            state.omega * self.angular_velocity_scale,
+            self.bias,
+        ]
+    }
+
+    /// Rejects non-finite values.
+    pub fn validate(&self) -> Result<(), String> {
+        let v = [
+            ("position_scale", self.position_scale),
+            ("velocity_scale", self.velocity_scale),
+            ("heading_scale", self.heading_scale),
+            ("angular_velocity_scale", self.angular_velocity_scale),
+            ("bias", self.bias),
+        ];
+        match v.iter().find(|(_, x)| !x.is_finite()) {
+            Some((name, x)) => Err(format!("sensors.{name} must be finite, got {x}")),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Gaussian white noise on the network's inputs (not the bias) and outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseSettings {
+    /// Standard deviation of the noise on every input but the bias. [paper] 0 (0.05 in robustness tests)
+    pub input_sd: f64,
+    /// Standard deviation of the noise on every output, before clamping to [0, 1]. [paper] 0
+    pub output_sd: f64,
+}
+
+impl NoiseSettings {
+    /// Rejects negative or non-finite deviations.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, sd) in [("input_sd", self.input_sd), ("output_sd", self.output_sd)] {
+            if !(sd.is_finite() && sd >= 0.0) {
+                return Err(format!("noise.{name} must be finite and >= 0, got {sd}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds input noise to every input but the last (the bias).
+    pub fn perturb_inputs(&self, inputs: &mut [f64], rng: &mut impl Rng) {
+        if self.input_sd > 0.0 {
+            let n = inputs.len() - 1;
+            for x in &mut inputs[..n] {
+                let noise: f64 = StandardNormal.sample(rng);
+                *x += self.input_sd * noise;
+            }
+        }
+    }
+
+    /// Adds output noise and clamps every output to [0, 1].
+    pub fn perturb_outputs(&self, outputs: &mut [f64], rng: &mut impl Rng) {
+        for u in outputs {
+            if self.output_sd > 0.0 {
+                let noise: f64 = StandardNormal.sample(rng);
+                *u += self.output_sd * noise;
+            }
+            *u = u.clamp(0.0, 1.0);
+        }
+    }
+}

@@ -1,0 +1,221 @@
+//! One trial of the control problem: a network flies the PSA for a fixed
+//! number of steps and earns fitness points step by step.
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::fitness::{FitnessSettings, StepError};
+use super::sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
+use super::task::{Target, Task, TaskSettings};
+use super::{BodySettings, THRUSTER_COUNT};
+use crate::network::Network;
+use crate::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, PhysicsError, StepSettings};
+use crate::rng::Stream;
+
+/// Errors of the PSA problem.
+#[derive(Debug, Error)]
+pub enum PsaError {
+    /// A setting has an impossible value.
+    #[error("invalid setting: {0}")]
+    Setting(String),
+    /// The network does not fit the PSA (7 inputs, 4 outputs).
+    #[error("network does not fit the PSA: {0}")]
+    Network(String),
+    /// The physics layer refused or failed.
+    #[error(transparent)]
+    Physics(#[from] PhysicsError),
+}
+
+/// Everything that defines the PSA control problem; every [chosen] value of
+/// the spec is one of these settings, recorded in every result file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PsaSettings {
+    /// Physics backend. [chosen] ode
+    pub backend: BackendKind,
+    /// Steps per trial. [chosen] 500 (25 s at dt 0.05 s)
+    pub steps: usize,
+    /// Trials per evaluation; the fitness is their mean. [paper] 1, 3 under noise or random initialisation
+    pub trials: usize,
+    /// Random initial conditions (tasks 1 and 3). [paper] false
+    pub random_init: bool,
+    /// The body.
+    pub body: BodySettings,
+    /// The simulation.
+    pub physics: StepSettings,
+    /// Input scaling.
+    pub sensors: SensorSettings,
+    /// Input and output noise.
+    pub noise: NoiseSettings,
+    /// Task constants.
+    pub tasks: TaskSettings,
+    /// The fitness function.
+    pub fitness: FitnessSettings,
+}
+
+impl Default for PsaSettings {
+    fn default() -> Self {
+        PsaSettings {
+            backend: BackendKind::Ode,
+            steps: 500,
+            trials: 1,
+            random_init: false,
+            body: BodySettings::default(),
+            physics: StepSettings::default(),
+            sensors: SensorSettings::default(),
+            noise: NoiseSettings::default(),
+            tasks: TaskSettings::default(),
+            fitness: FitnessSettings::default(),
+        }
+    }
+}
+
+impl PsaSettings {
+    /// Rejects impossible values, naming the setting.
+    pub fn validate(&self) -> Result<(), PsaError> {
+        if self.steps == 0 {
+            return Err(PsaError::Setting("steps must be >= 1, got 0".into()));
+        }
+        if self.trials == 0 {
+            return Err(PsaError::Setting("trials must be >= 1, got 0".into()));
+        }
+        self.sensors.validate().map_err(PsaError::Setting)?;
+        self.noise.validate().map_err(PsaError::Setting)?;
+        self.tasks.validate().map_err(PsaError::Setting)?;
+        self.fitness.validate().map_err(PsaError::Setting)?;
+        self.physics.validate()?;
+        self.body.model()?;
+        if !self.backend.is_available() {
+            return Err(PhysicsError::Unavailable(self.backend).into());
+        }
+        Ok(())
+    }
+}
+
+/// Everything that happened in one trial, for replay and pictures.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TrialRecord {
+    /// The target.
+    pub target: Target,
+    /// The state at the start and after every step.
+    pub states: Vec<BodyState>,
+    /// The thruster commands of every step (after noise and clamping).
+    pub outputs: Vec<[f64; THRUSTER_COUNT]>,
+    /// The points every step earned.
+    pub points: Vec<f64>,
+}
+
+/// Runs trials of one task; owns one physics world, reused between trials.
+pub struct TrialRunner {
+    settings: PsaSettings,
+    task: Task,
+    backend: Box<dyn PhysicsBackend>,
+}
+
+impl TrialRunner {
+    /// A runner for `task`; fails on invalid settings or when random
+    /// initialisation is asked of task 2, which has no such variant.
+    pub fn new(settings: &PsaSettings, task: Task) -> Result<TrialRunner, PsaError> {
+        settings.validate()?;
+        if settings.random_init && !task.has_random_init() {
+            return Err(PsaError::Setting(format!("task {task} has no random-initialisation variant")));
+        }
+        let model = settings.body.model()?;
+        let backend = create_backend(settings.backend, &model, &settings.physics)?;
+        Ok(TrialRunner {
+            settings: settings.clone(),
+            task,
+            backend,
+        })
+    }
+
+    /// The settings this runner uses.
+    pub fn settings(&self) -> &PsaSettings {
+        &self.settings
+    }
+
+    /// The task.
+    pub fn task(&self) -> Task {
+        self.task
+    }
+
+    /// The theoretical maximum of one trial, in points.
+    pub fn maximum_points(&self) -> f64 {
+        self.settings.fitness.maximum(self.settings.steps)
+    }
+
+    fn check_network(network: &Network) -> Result<(), PsaError> {
+        if network.inputs() != INPUT_COUNT || network.outputs() != THRUSTER_COUNT {
+            return Err(PsaError::Network(format!(
+                "it has {} inputs and {} outputs, the PSA needs {INPUT_COUNT} and {THRUSTER_COUNT}",
+                network.inputs(),
+                network.outputs()
+            )));
+        }
+        Ok(())
+    }
+
+    /// One trial; returns its points. Draws the random start (if any), then
+    /// the noise, from `rng`. Fills `record` when given.
+    pub fn run_trial(
+        &mut self,
+        network: &Network,
+        rng: &mut Stream,
+        mut record: Option<&mut TrialRecord>,
+    ) -> Result<f64, PsaError> {
+        Self::check_network(network)?;
+        let s = &self.settings;
+        let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
+        self.backend.reset(&start)?;
+        if let Some(r) = record.as_deref_mut() {
+            *r = TrialRecord {
+                target,
+                states: Vec::with_capacity(s.steps + 1),
+                outputs: Vec::with_capacity(s.steps),
+                points: Vec::with_capacity(s.steps),
+            };
+            r.states.push(start);
+        }
+        let mut outputs = [0.0; THRUSTER_COUNT];
+        let mut state = self.backend.state();
+        let mut points = 0.0;
+        for _ in 0..s.steps {
+            let mut inputs = s.sensors.inputs(&state, &target);
+            s.noise.perturb_inputs(&mut inputs, rng);
+            network.activate(&inputs, &mut outputs);
+            s.noise.perturb_outputs(&mut outputs, rng);
+            self.backend.step(&outputs)?;
+            let previous_omega = state.omega;
+            state = self.backend.state();
+            let step_points = s.fitness.points(&StepError {
+                x: state.x - target.x,
+                y: state.y - target.y,
+                heading: wrap_angle(state.heading - target.heading),
+                omega: state.omega,
+                previous_omega,
+            });
+            points += step_points;
+            if let Some(r) = record.as_deref_mut() {
+                r.states.push(state);
+                r.outputs.push(outputs);
+                r.points.push(step_points);
+            }
+        }
+        Ok(points)
+    }
+
+    /// The fitness of every trial, in % of the theoretical maximum.
+    pub fn evaluate_trials(&mut self, network: &Network, rng: &mut Stream) -> Result<Vec<f64>, PsaError> {
+        let maximum = self.maximum_points();
+        (0..self.settings.trials)
+            .map(|_| Ok(100.0 * self.run_trial(network, rng, None)? / maximum))
+            .collect()
+    }
+
+    /// The network's fitness: the mean over `trials` trials, in % of the
+    /// theoretical maximum.
+    pub fn evaluate(&mut self, network: &Network, rng: &mut Stream) -> Result<f64, PsaError> {
+        let trials = self.evaluate_trials(network, rng)?;
+        Ok(trials.iter().sum::<f64>() / trials.len() as f64)
+    }
+}
