@@ -6,9 +6,7 @@ use psa_esp::physics::{create_backend, BackendKind, BodyState, StepSettings};
 use psa_esp::psa::BodySettings;
 
 fn physics_step(c: &mut Criterion) {
-    let model = BodySettings::default()
-        .model()
-        .expect("default body is valid");
+    let model = BodySettings::default().model().expect("default body is valid");
     let settings = StepSettings::default();
     let mut group = c.benchmark_group("physics_step");
     for kind in BackendKind::available() {

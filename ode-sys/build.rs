@@ -11,10 +11,7 @@ fn main() {
     println!("cargo:rerun-if-changed=shim/ode_shim.c");
     println!("cargo:rerun-if-changed=shim/ode_shim.h");
 
-    let ode = match pkg_config::Config::new()
-        .atleast_version(MIN_ODE_VERSION)
-        .probe("ode")
-    {
+    let ode = match pkg_config::Config::new().atleast_version(MIN_ODE_VERSION).probe("ode") {
         Ok(lib) => lib,
         Err(err) => {
             eprintln!(
@@ -56,9 +53,8 @@ fn main() {
         });
     }
     // bindgen panics when it cannot load libclang: turn that into a message.
-    let generated =
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || builder.generate()))
-            .unwrap_or_else(|_| Err(bindgen::BindgenError::NotExist(PathBuf::from("libclang"))));
+    let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(move || builder.generate()))
+        .unwrap_or_else(|_| Err(bindgen::BindgenError::NotExist(PathBuf::from("libclang"))));
     let bindings = match generated {
         Ok(b) => b,
         Err(err) => {

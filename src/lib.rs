@@ -10,10 +10,13 @@
 //! 5. [`provenance`] and the command-line tools in [`cli`].
 
 pub mod cli;
+pub mod evolution;
+pub mod experiment;
 pub mod io;
 pub mod network;
 pub mod ode;
 pub mod physics;
+pub mod plots;
 pub mod provenance;
 pub mod psa;
 pub mod rng;

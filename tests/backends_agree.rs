@@ -1,8 +1,8 @@
 //! Backends against each other on seeded random thrust sequences.
 
 use psa_esp::physics::{
-    create_backend, crosscheck, random_thrust_sequence, tolerance, trajectory, BackendKind,
-    BodyState, Deviation, PlaneConstraint, StepSettings, Stepper,
+    create_backend, crosscheck, random_thrust_sequence, tolerance, trajectory, BackendKind, BodyState, Deviation,
+    PlaneConstraint, StepSettings, Stepper,
 };
 use psa_esp::psa::BodySettings;
 
@@ -40,11 +40,7 @@ fn rapier_agrees_with_ode_within_its_stated_tolerance() {
         .find(|c| c.backend == BackendKind::Rapier)
         .unwrap();
     assert_eq!(rapier.tolerance, tolerance(BackendKind::Rapier));
-    assert!(
-        rapier.passed,
-        "{:?} exceeds {:?}",
-        rapier.deviation, rapier.tolerance
-    );
+    assert!(rapier.passed, "{:?} exceeds {:?}", rapier.deviation, rapier.tolerance);
 }
 
 fn max_deviation(a: StepSettings, b: StepSettings, sequences: u64) -> (Deviation, bool) {

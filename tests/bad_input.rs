@@ -19,10 +19,7 @@ fn non_positive_density_or_mass_is_an_error_naming_the_value() {
             ..BodySettings::default()
         };
         let msg = err_text(body.model());
-        assert!(
-            msg.contains("density") && msg.contains(&density.to_string()),
-            "{msg}"
-        );
+        assert!(msg.contains("density") && msg.contains(&density.to_string()), "{msg}");
         let msg = err_text(Mass::cuboid(density, [1.0, 1.0, 1.0]));
         assert!(msg.contains("density"), "{msg}");
     }
@@ -52,10 +49,7 @@ fn a_mass_ode_would_abort_on_is_refused_before_ode_sees_it() {
     let mut off_centre = Mass::cuboid(1000.0, [0.1, 0.1, 0.1]).unwrap();
     off_centre.translate([0.05, 0.0, 0.0]).unwrap();
     let msg = err_text(body.set_mass(&off_centre));
-    assert!(
-        msg.contains("centre of mass") && msg.contains("0.05"),
-        "{msg}"
-    );
+    assert!(msg.contains("centre of mass") && msg.contains("0.05"), "{msg}");
     let msg = err_text(off_centre.translate([f64::NAN, 0.0, 0.0]));
     assert!(msg.contains("NaN"), "{msg}");
     // A valid mass is accepted and stored as given.
@@ -69,17 +63,9 @@ fn nan_or_out_of_range_thrust_is_an_error_on_every_backend() {
     let model = BodySettings::default().model().unwrap();
     for kind in BackendKind::available() {
         let mut b = create_backend(kind, &model, &StepSettings::default()).unwrap();
-        for (thrust, shown) in [
-            (f64::NAN, "NaN"),
-            (1.5, "1.5"),
-            (-0.2, "-0.2"),
-            (f64::INFINITY, "inf"),
-        ] {
+        for (thrust, shown) in [(f64::NAN, "NaN"), (1.5, "1.5"), (-0.2, "-0.2"), (f64::INFINITY, "inf")] {
             let msg = err_text(b.step(&[0.0, thrust, 0.0, 0.0]));
-            assert!(
-                msg.contains("thruster 1") && msg.contains(shown),
-                "{kind}: {msg}"
-            );
+            assert!(msg.contains("thruster 1") && msg.contains(shown), "{kind}: {msg}");
         }
         let msg = err_text(b.step(&[0.0; 3]));
         assert!(msg.contains("expected 4"), "{kind}: {msg}");
@@ -103,17 +89,11 @@ fn non_positive_time_step_is_an_error() {
         };
         for kind in BackendKind::available() {
             let msg = err_text(create_backend(kind, &model, &settings));
-            assert!(
-                msg.contains("dt") && msg.contains(&dt.to_string()),
-                "{kind}: {msg}"
-            );
+            assert!(msg.contains("dt") && msg.contains(&dt.to_string()), "{kind}: {msg}");
         }
         let world = World::new().unwrap();
         let msg = err_text(world.step(dt));
-        assert!(
-            msg.contains("dt") && msg.contains(&format!("{dt:?}")),
-            "{msg}"
-        );
+        assert!(msg.contains("dt") && msg.contains(&format!("{dt:?}")), "{msg}");
         let msg = err_text(world.quick_step(dt));
         assert!(msg.contains("dt"), "{msg}");
     }

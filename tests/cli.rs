@@ -66,10 +66,7 @@ fn simulate_reads_a_thrust_file_and_prints_to_stdout() {
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     assert_eq!(rows.len(), 4);
-    assert!(
-        rows[3][6] > 0.0,
-        "thruster 0 spins the body anticlockwise: {rows:?}"
-    );
+    assert!(rows[3][6] > 0.0, "thruster 0 spins the body anticlockwise: {rows:?}");
     assert!(
         rows[3][2] > 0.0,
         "the start velocity 0.1 m/s along y carries it: {rows:?}"
@@ -87,10 +84,7 @@ fn bad_arguments_get_a_clear_error_and_a_nonzero_exit() {
         (&["simulate", "--thrust", "0,2,0,0"], "thruster 1: 2"),
         (&["simulate", "--thrust", "0,0,0"], "4 comma-separated"),
         (&["simulate", "--thrust", "0,0,0,0", "--dt", "-1"], "dt"),
-        (
-            &["simulate", "--thrust-file", bad_file],
-            "line 1: expected 4",
-        ),
+        (&["simulate", "--thrust-file", bad_file], "line 1: expected 4"),
         (
             &["simulate", "--thrust-file", "/nonexistent/thrust.txt"],
             "/nonexistent/thrust.txt",
@@ -131,7 +125,5 @@ fn bench_prints_ns_per_step_for_every_backend() {
     let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let rows = report["physics_step"].as_array().unwrap();
     assert_eq!(rows.len(), psa_esp::physics::BackendKind::available().len());
-    assert!(rows
-        .iter()
-        .all(|r| r["median_ns_per_step"].as_f64().unwrap() > 0.0));
+    assert!(rows.iter().all(|r| r["median_ns_per_step"].as_f64().unwrap() > 0.0));
 }

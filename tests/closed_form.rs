@@ -2,9 +2,7 @@
 
 use std::f64::consts::PI;
 
-use psa_esp::physics::{
-    create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, StepSettings,
-};
+use psa_esp::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, StepSettings};
 use psa_esp::psa::BodySettings;
 
 fn backend(kind: BackendKind) -> Box<dyn PhysicsBackend> {
@@ -28,10 +26,7 @@ fn hand_mass_and_izz() -> (f64, f64) {
 #[test]
 fn mass_centre_and_inertia_match_hand_computation() {
     let (mass, izz) = hand_mass_and_izz();
-    assert!(
-        (mass - 3.2055926535897936).abs() < 1e-12,
-        "hand mass {mass}"
-    );
+    assert!((mass - 3.2055926535897936).abs() < 1e-12, "hand mass {mass}");
     // Ixx: hull m (3 r^2 + h^2) / 12; boxes on the x axis (thrusters 1, 3,
     // long side along y) and on the y axis (thrusters 0, 2, long side along x).
     let rho = 1000.0;
@@ -42,11 +37,7 @@ fn mass_centre_and_inertia_match_hand_computation() {
         + 2.0 * (m_box * (0.02 * 0.02 + 0.02 * 0.02) / 12.0 + m_box * 0.12 * 0.12); // boxes at (0, +-r)
     for kind in BackendKind::available() {
         let p = backend(kind).mass_properties();
-        assert!(
-            (p.mass - mass).abs() < 1e-12 * mass,
-            "{kind}: mass {}",
-            p.mass
-        );
+        assert!((p.mass - mass).abs() < 1e-12 * mass, "{kind}: mass {}", p.mass);
         assert!(
             (p.inertia[2][2] - izz).abs() < 1e-12 * izz,
             "{kind}: Izz {} vs {izz}",
@@ -63,11 +54,7 @@ fn mass_centre_and_inertia_match_hand_computation() {
                 "{kind}: Ixx {} vs {ixx}",
                 p.inertia[0][0]
             );
-            assert!(
-                (p.inertia[1][1] - ixx).abs() < 1e-12,
-                "{kind}: Iyy {}",
-                p.inertia[1][1]
-            );
+            assert!((p.inertia[1][1] - ixx).abs() < 1e-12, "{kind}: Iyy {}", p.inertia[1][1]);
         }
     }
 }
@@ -127,11 +114,7 @@ fn free_spin_keeps_omega_and_turns_by_the_integrators_rule() {
                 "{kind}: omega changed without torque: {}",
                 s.omega
             );
-            assert_eq!(
-                (s.x, s.y, s.vx, s.vy),
-                (0.0, 0.0, 0.0, 0.0),
-                "{kind}: drifted"
-            );
+            assert_eq!((s.x, s.y, s.vx, s.vy), (0.0, 0.0, 0.0, 0.0), "{kind}: drifted");
             // ODE (and native) advance 2 atan(w dt / 2) per step, rapier atan(w dt).
             let per_step = if kind == BackendKind::Rapier {
                 dt.atan()
@@ -177,18 +160,12 @@ fn thruster_table_pins_directions_and_torques() {
         let mut b = backend(kind);
         b.step(&[0.6, 0.0, 0.6, 0.0]).unwrap();
         let s = b.state();
-        assert!(
-            s.vx > 0.0 && s.vy == 0.0 && s.omega == 0.0,
-            "{kind} u0=u2: {s:?}"
-        );
+        assert!(s.vx > 0.0 && s.vy == 0.0 && s.omega == 0.0, "{kind} u0=u2: {s:?}");
         // u1 = u3: pure body +y, no spin.
         let mut b = backend(kind);
         b.step(&[0.0, 0.8, 0.0, 0.8]).unwrap();
         let s = b.state();
-        assert!(
-            s.vy > 0.0 && s.vx == 0.0 && s.omega == 0.0,
-            "{kind} u1=u3: {s:?}"
-        );
+        assert!(s.vy > 0.0 && s.vx == 0.0 && s.omega == 0.0, "{kind} u1=u3: {s:?}");
         // u0 alone: anticlockwise spin and a drift towards +x.
         let mut b = backend(kind);
         b.step(&[1.0, 0.0, 0.0, 0.0]).unwrap();
@@ -202,11 +179,7 @@ fn thruster_table_pins_directions_and_torques() {
         ] {
             let mut b = backend(kind);
             b.step(&thrust).unwrap();
-            assert!(
-                b.state().omega * sign > 0.0,
-                "{kind} {thrust:?}: {:?}",
-                b.state()
-            );
+            assert!(b.state().omega * sign > 0.0, "{kind} {thrust:?}: {:?}", b.state());
         }
         // Torque of one thruster: r F / Izz per second.
         let (_, izz) = hand_mass_and_izz();
@@ -233,9 +206,6 @@ fn body_thrust_turns_with_the_body() {
         .unwrap();
         b.step(&[1.0, 0.0, 1.0, 0.0]).unwrap();
         let s = b.state();
-        assert!(
-            s.vy > 0.0 && s.vx.abs() < 1e-15 && s.omega == 0.0,
-            "{kind}: {s:?}"
-        );
+        assert!(s.vy > 0.0 && s.vx.abs() < 1e-15 && s.omega == 0.0, "{kind}: {s:?}");
     }
 }

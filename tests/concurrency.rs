@@ -2,9 +2,7 @@
 //! thread that steps it, give bit-identical results to stepping them one by one.
 
 use psa_esp::ode::thread_pool;
-use psa_esp::physics::{
-    create_backend, random_thrust_sequence, trajectory, BackendKind, BodyState, StepSettings,
-};
+use psa_esp::physics::{create_backend, random_thrust_sequence, trajectory, BackendKind, BodyState, StepSettings};
 use psa_esp::psa::BodySettings;
 use rayon::prelude::*;
 
@@ -26,12 +24,8 @@ fn parallel_worlds_are_bit_identical_to_serial_ones() {
         let serial: Vec<_> = (0..WORLDS).map(|i| run(kind, i)).collect();
         for threads in [2, 4, 8] {
             let pool = thread_pool(threads).unwrap();
-            let parallel: Vec<_> =
-                pool.install(|| (0..WORLDS).into_par_iter().map(|i| run(kind, i)).collect());
-            assert!(
-                serial == parallel,
-                "{kind}: {threads} threads differ from serial"
-            );
+            let parallel: Vec<_> = pool.install(|| (0..WORLDS).into_par_iter().map(|i| run(kind, i)).collect());
+            assert!(serial == parallel, "{kind}: {threads} threads differ from serial");
         }
     }
 }

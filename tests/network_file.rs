@@ -28,10 +28,14 @@ fn save_and_load_round_trip_exactly() {
     let (loaded_file, loaded) = NetworkFile::load(&path).unwrap();
     assert_eq!(loaded, net);
     assert_eq!(loaded_file, file);
-    assert!(loaded.genes().iter().zip(net.genes()).all(|(a, b)| a.to_bits() == b.to_bits()));
+    assert!(loaded
+        .genes()
+        .iter()
+        .zip(net.genes())
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
     assert_eq!(loaded_file.task, Task::StopAtPosition);
     assert_eq!(loaded_file.provenance["seed"], 42);
-    for key in ["tool_version", "git_commit", "libode_version", "created"] {
+    for key in ["tool_version", "git_commit", "libode_version"] {
         assert!(loaded_file.provenance[key].is_string(), "provenance lacks {key}");
     }
     // Saving what was loaded gives the same bytes.
@@ -41,7 +45,12 @@ fn save_and_load_round_trip_exactly() {
 }
 
 fn valid_json() -> serde_json::Value {
-    let file = NetworkFile::new(&sample_network(), Task::Turn, SensorSettings::default(), serde_json::Map::new());
+    let file = NetworkFile::new(
+        &sample_network(),
+        Task::Turn,
+        SensorSettings::default(),
+        serde_json::Map::new(),
+    );
     serde_json::to_value(&file).unwrap()
 }
 
@@ -50,20 +59,56 @@ fn malformed_files_are_rejected_with_the_file_and_the_problem() {
     let dir = tempfile::tempdir().unwrap();
     let mut cases: Vec<(&str, String, &str)> = vec![
         ("not-json", "this is not json".into(), "not valid JSON"),
-        ("nan", valid_json().to_string().replacen("\"weights\":[", "\"weights\":[NaN,", 1), "not valid JSON"),
-        ("huge", valid_json().to_string().replacen("\"weights\":[", "\"weights\":[1e999,", 1), "not valid JSON"),
+        (
+            "nan",
+            valid_json()
+                .to_string()
+                .replacen("\"weights\":[", "\"weights\":[NaN,", 1),
+            "not valid JSON",
+        ),
+        (
+            "huge",
+            valid_json()
+                .to_string()
+                .replacen("\"weights\":[", "\"weights\":[1e999,", 1),
+            "not valid JSON",
+        ),
     ];
     let mutations: Vec<(&str, fn(&mut serde_json::Value), &str)> = vec![
         ("version", |v| v["version"] = 99.into(), "unknown version 99"),
-        ("format", |v| v["format"] = "something-else".into(), "format is \"something-else\""),
-        ("no-format", |v| drop(v.as_object_mut().unwrap().remove("format")), "not a psa-esp network file"),
-        ("hidden-count", |v| v["topology"]["hidden"] = 6.into(), "topology says 6 hidden neurons, the file has 5"),
-        ("neuron-size", |v| drop(v["neurons"][2]["weights"].as_array_mut().unwrap().pop()), "hidden neuron 2 has 10 weights"),
-        ("string-weight", |v| v["neurons"][0]["weights"][4] = "NaN".into(), "invalid type"),
+        (
+            "format",
+            |v| v["format"] = "something-else".into(),
+            "format is \"something-else\"",
+        ),
+        (
+            "no-format",
+            |v| drop(v.as_object_mut().unwrap().remove("format")),
+            "not a psa-esp network file",
+        ),
+        (
+            "hidden-count",
+            |v| v["topology"]["hidden"] = 6.into(),
+            "topology says 6 hidden neurons, the file has 5",
+        ),
+        (
+            "neuron-size",
+            |v| drop(v["neurons"][2]["weights"].as_array_mut().unwrap().pop()),
+            "hidden neuron 2 has 10 weights",
+        ),
+        (
+            "string-weight",
+            |v| v["neurons"][0]["weights"][4] = "NaN".into(),
+            "invalid type",
+        ),
         ("activation", |v| v["activation"] = "tanh".into(), "activation \"tanh\""),
         ("task", |v| v["task"] = 4.into(), "task must be 1, 2 or 3"),
         ("unknown-field", |v| v["extra"] = 1.into(), "unknown field `extra`"),
-        ("inputs", |v| v["topology"]["inputs"] = 0.into(), "inputs and outputs must be >= 1"),
+        (
+            "inputs",
+            |v| v["topology"]["inputs"] = 0.into(),
+            "inputs and outputs must be >= 1",
+        ),
     ];
     for (name, mutate, needle) in mutations {
         let mut v = valid_json();

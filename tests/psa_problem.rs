@@ -6,8 +6,8 @@ use psa_esp::network::Network;
 use psa_esp::physics::{BackendKind, BodyState};
 use psa_esp::psa::fitness::StepError;
 use psa_esp::psa::{
-    FitnessKind, FitnessSettings, NoiseSettings, PsaSettings, SensorSettings, Target, Task, TaskSettings,
-    TrialRecord, TrialRunner,
+    FitnessKind, FitnessSettings, NoiseSettings, PsaSettings, SensorSettings, Target, Task, TaskSettings, TrialRecord,
+    TrialRunner,
 };
 use psa_esp::rng::stream;
 use rand::RngExt;
@@ -28,11 +28,20 @@ fn random_network(seed: u64, hidden: usize) -> Network {
 }
 
 fn fitness(settings: &PsaSettings, task: Task, network: &Network, seed: u64) -> f64 {
-    TrialRunner::new(settings, task).unwrap().evaluate(network, &mut stream(seed, &[])).unwrap()
+    TrialRunner::new(settings, task)
+        .unwrap()
+        .evaluate(network, &mut stream(seed, &[]))
+        .unwrap()
 }
 
 fn step(x: f64, y: f64, heading: f64, omega: f64, previous_omega: f64) -> StepError {
-    StepError { x, y, heading, omega, previous_omega }
+    StepError {
+        x,
+        y,
+        heading,
+        omega,
+        previous_omega,
+    }
 }
 
 #[test]
@@ -63,7 +72,10 @@ fn incremental_fitness_scores_box_spin_and_heading_as_specified() {
 
 #[test]
 fn original_fitness_needs_box_and_heading_only() {
-    let f = FitnessSettings { kind: FitnessKind::Original, ..FitnessSettings::default() };
+    let f = FitnessSettings {
+        kind: FitnessKind::Original,
+        ..FitnessSettings::default()
+    };
     assert_eq!(f.points(&step(0.1, 0.1, 0.01, 0.0, 0.0)), 1.0);
     assert_eq!(f.points(&step(0.1, 0.1, 0.01, 3.0, 1.0)), 1.0, "spin does not matter");
     assert_eq!(f.points(&step(0.1, 0.1, 0.06, 0.0, 0.0)), 0.0);
@@ -74,10 +86,15 @@ fn original_fitness_needs_box_and_heading_only() {
 #[test]
 fn a_hand_built_trajectory_scores_step_by_step() {
     // Through a trial: record the points and re-score them by hand.
-    let settings = PsaSettings { backend: BackendKind::Native, ..PsaSettings::default() };
+    let settings = PsaSettings {
+        backend: BackendKind::Native,
+        ..PsaSettings::default()
+    };
     let mut runner = TrialRunner::new(&settings, Task::StopAtPosition).unwrap();
     let mut record = TrialRecord::default();
-    let total = runner.run_trial(&constant_network(0.0), &mut stream(1, &[]), Some(&mut record)).unwrap();
+    let total = runner
+        .run_trial(&constant_network(0.0), &mut stream(1, &[]), Some(&mut record))
+        .unwrap();
     assert_eq!(record.states.len(), 501);
     // Coasting at 0.1 m/s along +y: in the box (|y - 0.4| < 0.2) for steps
     // 41..=119 in exact arithmetic (step 40 sits on the edge, y = 0.2, and
@@ -94,10 +111,21 @@ fn a_hand_built_trajectory_scores_step_by_step() {
 #[test]
 fn doing_nothing_scores_0_25_and_4_percent() {
     for backend in [BackendKind::Ode, BackendKind::Native] {
-        let settings = PsaSettings { backend, ..PsaSettings::default() };
+        let settings = PsaSettings {
+            backend,
+            ..PsaSettings::default()
+        };
         let idle = constant_network(0.0);
-        assert_eq!(fitness(&settings, Task::StopRotation, &idle, 1), 0.0, "{backend}: it spins forever");
-        assert_eq!(fitness(&settings, Task::Turn, &idle, 1), 25.0, "{backend}: in the box, never turned");
+        assert_eq!(
+            fitness(&settings, Task::StopRotation, &idle, 1),
+            0.0,
+            "{backend}: it spins forever"
+        );
+        assert_eq!(
+            fitness(&settings, Task::Turn, &idle, 1),
+            25.0,
+            "{backend}: in the box, never turned"
+        );
         let t3 = fitness(&settings, Task::StopAtPosition, &idle, 1);
         assert!((3.95..=4.0).contains(&t3), "{backend}: coasting through the box: {t3}");
     }
@@ -114,15 +142,30 @@ fn firing_every_thruster_fully_scores_under_1_percent() {
 
 #[test]
 fn ode_and_native_give_the_same_fitness_with_and_without_noise() {
-    let noisy = NoiseSettings { input_sd: 0.05, output_sd: 0.05 };
+    let noisy = NoiseSettings {
+        input_sd: 0.05,
+        output_sd: 0.05,
+    };
     for noise in [NoiseSettings::default(), noisy] {
         for task in Task::ALL {
             for k in 0..8 {
                 let net = random_network(100 + k, 5);
-                let mut s = PsaSettings { noise, trials: 2, ..PsaSettings::default() };
+                let mut s = PsaSettings {
+                    noise,
+                    trials: 2,
+                    ..PsaSettings::default()
+                };
                 s.random_init = task.has_random_init() && noise.input_sd > 0.0;
                 let ode = fitness(&s, task, &net, k);
-                let native = fitness(&PsaSettings { backend: BackendKind::Native, ..s.clone() }, task, &net, k);
+                let native = fitness(
+                    &PsaSettings {
+                        backend: BackendKind::Native,
+                        ..s.clone()
+                    },
+                    task,
+                    &net,
+                    k,
+                );
                 assert_eq!(ode, native, "task {task}, network {k}, noise {noise:?}");
                 // The same inputs give the same fitness.
                 assert_eq!(ode, fitness(&s, task, &net, k));
@@ -134,14 +177,23 @@ fn ode_and_native_give_the_same_fitness_with_and_without_noise() {
 #[test]
 fn random_networks_earn_varied_fitness() {
     // The problem discriminates: not every network scores the same.
-    let scores: Vec<f64> = (0..20).map(|k| fitness(&PsaSettings::default(), Task::Turn, &random_network(k, 5), 0)).collect();
-    let distinct = scores.iter().map(|s| s.to_bits()).collect::<std::collections::HashSet<_>>().len();
+    let scores: Vec<f64> = (0..20)
+        .map(|k| fitness(&PsaSettings::default(), Task::Turn, &random_network(k, 5), 0))
+        .collect();
+    let distinct = scores
+        .iter()
+        .map(|s| s.to_bits())
+        .collect::<std::collections::HashSet<_>>()
+        .len();
     assert!(distinct >= 5, "{scores:?}");
 }
 
 #[test]
 fn injected_noise_has_the_configured_mean_and_sd() {
-    let noise = NoiseSettings { input_sd: 0.05, output_sd: 0.2 };
+    let noise = NoiseSettings {
+        input_sd: 0.05,
+        output_sd: 0.2,
+    };
     let mut rng = stream(9, &[]);
     let n = 40_000;
     let mut samples = Vec::with_capacity(n * 6);
@@ -167,7 +219,10 @@ fn injected_noise_has_the_configured_mean_and_sd() {
     let mean = outs.iter().sum::<f64>() / n as f64;
     let sd = (outs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
     assert!((mean - 0.5).abs() < 5e-3, "output mean {mean}");
-    assert!((sd - 0.2).abs() < 5e-3, "output sd {sd} (clamping at 0.5 +- 2.5 sd barely matters)");
+    assert!(
+        (sd - 0.2).abs() < 5e-3,
+        "output sd {sd} (clamping at 0.5 +- 2.5 sd barely matters)"
+    );
     // No noise configured: no draw, no change.
     let mut u = [0.3; 4];
     NoiseSettings::default().perturb_outputs(&mut u, &mut rng);
@@ -179,19 +234,54 @@ fn start_states_and_targets_are_as_specified() {
     let t = TaskSettings::default();
     let mut rng = stream(3, &[]);
     let (s1, g1) = t.start_and_target(Task::StopRotation, false, &mut rng);
-    assert_eq!((s1, g1), (BodyState { omega: 1.0, ..BodyState::default() }, Target::default()));
+    assert_eq!(
+        (s1, g1),
+        (
+            BodyState {
+                omega: 1.0,
+                ..BodyState::default()
+            },
+            Target::default()
+        )
+    );
     let (s2, g2) = t.start_and_target(Task::Turn, false, &mut rng);
-    assert_eq!((s2, g2), (BodyState::default(), Target { heading: FRAC_PI_2, ..Target::default() }));
+    assert_eq!(
+        (s2, g2),
+        (
+            BodyState::default(),
+            Target {
+                heading: FRAC_PI_2,
+                ..Target::default()
+            }
+        )
+    );
     let (s3, g3) = t.start_and_target(Task::StopAtPosition, false, &mut rng);
-    assert_eq!(s3, BodyState { vy: 0.1, ..BodyState::default() });
-    assert_eq!(g3, Target { x: 0.0, y: 0.40, heading: PI });
+    assert_eq!(
+        s3,
+        BodyState {
+            vy: 0.1,
+            ..BodyState::default()
+        }
+    );
+    assert_eq!(
+        g3,
+        Target {
+            x: 0.0,
+            y: 0.40,
+            heading: PI
+        }
+    );
     // Random initialisation: task 1 heading uniform in (-pi, pi], task 3 distance uniform in [0.25, 0.55].
-    let headings: Vec<f64> = (0..20_000).map(|_| t.start_and_target(Task::StopRotation, true, &mut rng).0.heading).collect();
+    let headings: Vec<f64> = (0..20_000)
+        .map(|_| t.start_and_target(Task::StopRotation, true, &mut rng).0.heading)
+        .collect();
     assert!(headings.iter().all(|h| *h > -PI && *h <= PI));
     let mean = headings.iter().sum::<f64>() / headings.len() as f64;
     assert!(mean.abs() < 0.05, "mean {mean}");
     assert!(headings.iter().any(|h| *h < -3.0) && headings.iter().any(|h| *h > 3.0));
-    let distances: Vec<f64> = (0..20_000).map(|_| t.start_and_target(Task::StopAtPosition, true, &mut rng).1.y).collect();
+    let distances: Vec<f64> = (0..20_000)
+        .map(|_| t.start_and_target(Task::StopAtPosition, true, &mut rng).1.y)
+        .collect();
     assert!(distances.iter().all(|d| (0.25..=0.55).contains(d)));
     let mean = distances.iter().sum::<f64>() / distances.len() as f64;
     assert!((mean - 0.40).abs() < 0.005, "mean {mean}");
@@ -200,14 +290,33 @@ fn start_states_and_targets_are_as_specified() {
 
 #[test]
 fn random_init_is_refused_for_task_2_and_bad_settings_name_themselves() {
-    let s = PsaSettings { random_init: true, ..PsaSettings::default() };
+    let s = PsaSettings {
+        random_init: true,
+        ..PsaSettings::default()
+    };
     let err = TrialRunner::new(&s, Task::Turn).err().unwrap().to_string();
     assert!(err.contains("task 2"), "{err}");
-    let s = PsaSettings { noise: NoiseSettings { input_sd: -0.1, output_sd: 0.0 }, ..PsaSettings::default() };
+    let s = PsaSettings {
+        noise: NoiseSettings {
+            input_sd: -0.1,
+            output_sd: 0.0,
+        },
+        ..PsaSettings::default()
+    };
     let err = TrialRunner::new(&s, Task::Turn).err().unwrap().to_string();
     assert!(err.contains("noise.input_sd") && err.contains("-0.1"), "{err}");
-    let s = PsaSettings { sensors: SensorSettings { bias: f64::NAN, ..SensorSettings::default() }, ..PsaSettings::default() };
-    assert!(TrialRunner::new(&s, Task::Turn).err().unwrap().to_string().contains("sensors.bias"));
+    let s = PsaSettings {
+        sensors: SensorSettings {
+            bias: f64::NAN,
+            ..SensorSettings::default()
+        },
+        ..PsaSettings::default()
+    };
+    assert!(TrialRunner::new(&s, Task::Turn)
+        .err()
+        .unwrap()
+        .to_string()
+        .contains("sensors.bias"));
     let wrong = Network::from_genes(3, 4, vec![0.0; 7]).unwrap();
     let mut runner = TrialRunner::new(&PsaSettings::default(), Task::Turn).unwrap();
     let err = runner.evaluate(&wrong, &mut stream(0, &[])).unwrap_err().to_string();
@@ -217,8 +326,19 @@ fn random_init_is_refused_for_task_2_and_bad_settings_name_themselves() {
 #[test]
 fn inputs_are_relative_to_the_target_scaled_and_wrapped() {
     let s = SensorSettings::default();
-    let state = BodyState { x: 0.1, y: 0.5, heading: -3.0, vx: -0.2, vy: 0.05, omega: 0.7 };
-    let target = Target { x: 0.0, y: 0.4, heading: PI };
+    let state = BodyState {
+        x: 0.1,
+        y: 0.5,
+        heading: -3.0,
+        vx: -0.2,
+        vy: 0.05,
+        omega: 0.7,
+    };
+    let target = Target {
+        x: 0.0,
+        y: 0.4,
+        heading: PI,
+    };
     let i = s.inputs(&state, &target);
     assert!((i[0] - 1.0).abs() < 1e-12 && (i[1] - 1.0).abs() < 1e-12);
     assert!((i[2] + 2.0).abs() < 1e-12 && (i[3] - 0.5).abs() < 1e-12);

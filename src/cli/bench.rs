@@ -106,7 +106,10 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         println!("machine: {} ({} cores)", machine.cpu, machine.cores);
-        println!("physics step, PSA body, dt {} s ({} rounds x {} steps, median):", settings.dt, args.rounds, args.steps);
+        println!(
+            "physics step, PSA body, dt {} s ({} rounds x {} steps, median):",
+            settings.dt, args.rounds, args.steps
+        );
         println!("{:<8} {:>10} {:>10} {:>8}", "backend", "ns/step", "min", "vs ode");
         for t in &timings {
             println!(

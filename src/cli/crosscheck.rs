@@ -29,7 +29,13 @@ pub struct CrosscheckArgs {
 pub fn run(args: CrosscheckArgs) -> Result<i32> {
     let settings = args.physics.settings()?;
     let model = BodySettings::default().model()?;
-    let report = crosscheck(&model, &settings, args.sequences as usize, args.steps as usize, args.seed)?;
+    let report = crosscheck(
+        &model,
+        &settings,
+        args.sequences as usize,
+        args.steps as usize,
+        args.seed,
+    )?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

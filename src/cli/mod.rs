@@ -2,7 +2,10 @@
 
 mod bench;
 mod crosscheck;
+mod replay;
 mod simulate;
+
+use std::fmt::Write as _;
 
 use clap::{Parser, Subcommand};
 
@@ -27,6 +30,8 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Run random thrust sequences on every backend and compare each with ODE.
     Crosscheck(crosscheck::CrosscheckArgs),
+    /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
+    Replay(replay::ReplayArgs),
     /// Measure ns per physics step of every backend in one run.
     Bench(bench::BenchArgs),
 }
@@ -36,6 +41,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
     match cli.command {
         Command::Simulate(args) => simulate::run(args),
         Command::Crosscheck(args) => crosscheck::run(args),
+        Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }
@@ -60,7 +66,11 @@ impl PhysicsArgs {
         use crate::physics::{PlaneConstraint, StepSettings, Stepper};
         let settings = StepSettings {
             dt: self.dt,
-            stepper: if self.stepper == "quick" { Stepper::Quick } else { Stepper::Exact },
+            stepper: if self.stepper == "quick" {
+                Stepper::Quick
+            } else {
+                Stepper::Exact
+            },
             plane_constraint: if self.plane == "plane2d" {
                 PlaneConstraint::Plane2dJoint
             } else {
@@ -71,4 +81,31 @@ impl PhysicsArgs {
         settings.validate()?;
         Ok(settings)
     }
+}
+
+/// A trajectory as CSV: `t,x,y,heading,vx,vy,omega` (SI units), then the
+/// columns named in `extra_header` (which starts with a comma when not
+/// empty) filled per row by `extra(row)`.
+pub fn trajectory_csv(
+    states: &[crate::physics::BodyState],
+    dt: f64,
+    extra_header: &str,
+    extra: impl Fn(usize) -> String,
+) -> String {
+    let mut csv = format!("t,x,y,heading,vx,vy,omega{extra_header}\n");
+    for (i, s) in states.iter().enumerate() {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{}{}",
+            i as f64 * dt,
+            s.x,
+            s.y,
+            s.heading,
+            s.vx,
+            s.vy,
+            s.omega,
+            extra(i)
+        );
+    }
+    csv
 }

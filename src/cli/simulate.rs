@@ -1,6 +1,5 @@
 //! `psa-esp simulate`: the PSA under given thrust, trajectory as CSV.
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
@@ -16,8 +15,13 @@ pub struct SimulateArgs {
     #[arg(long, value_enum, default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Constant thrust of the four thrusters, each in [0, 1]: u0,u1,u2,u3.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true,
-          conflicts_with = "thrust_file", required_unless_present = "thrust_file")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        conflicts_with = "thrust_file",
+        required_unless_present = "thrust_file"
+    )]
     pub thrust: Option<Vec<f64>>,
     /// A file with one row of four thrust values per step (comma or
     /// whitespace separated; '#' starts a comment).
@@ -27,7 +31,12 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub steps: Option<usize>,
     /// Start state x,y,heading,vx,vy,omega (m, rad, m/s, rad/s).
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, default_value = "0,0,0,0,0,0")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        default_value = "0,0,0,0,0,0"
+    )]
     pub start: Vec<f64>,
     /// Write the trajectory here instead of standard output.
     #[arg(long)]
@@ -73,7 +82,10 @@ fn commands(args: &SimulateArgs) -> Result<Vec<Vec<f64>>> {
     match (&args.thrust, &args.thrust_file) {
         (Some(thrust), _) => {
             if thrust.len() != THRUSTER_COUNT {
-                bail!("--thrust takes {THRUSTER_COUNT} comma-separated values u0,u1,u2,u3, got {}", thrust.len());
+                bail!(
+                    "--thrust takes {THRUSTER_COUNT} comma-separated values u0,u1,u2,u3, got {}",
+                    thrust.len()
+                );
             }
             Ok(vec![thrust.clone(); args.steps.unwrap_or(DEFAULT_STEPS)])
         }
@@ -91,15 +103,6 @@ fn commands(args: &SimulateArgs) -> Result<Vec<Vec<f64>>> {
     }
 }
 
-/// The trajectory as CSV: t, x, y, heading, vx, vy, omega (SI units).
-pub fn trajectory_csv(states: &[BodyState], dt: f64) -> String {
-    let mut csv = String::from("t,x,y,heading,vx,vy,omega\n");
-    for (i, s) in states.iter().enumerate() {
-        let _ = writeln!(csv, "{},{},{},{},{},{},{}", i as f64 * dt, s.x, s.y, s.heading, s.vx, s.vy, s.omega);
-    }
-    csv
-}
-
 /// Runs `simulate`.
 pub fn run(args: SimulateArgs) -> Result<i32> {
     let settings = args.physics.settings()?;
@@ -108,10 +111,17 @@ pub fn run(args: SimulateArgs) -> Result<i32> {
     let [x, y, heading, vx, vy, omega] = args.start[..] else {
         bail!("--start takes six values: x,y,heading,vx,vy,omega");
     };
-    let start = BodyState { x, y, heading, vx, vy, omega };
+    let start = BodyState {
+        x,
+        y,
+        heading,
+        vx,
+        vy,
+        omega,
+    };
     let mut backend = create_backend(args.backend, &model, &settings)?;
     let states = trajectory(backend.as_mut(), &start, &commands)?;
-    let csv = trajectory_csv(&states, settings.dt);
+    let csv = super::trajectory_csv(&states, settings.dt, "", |_| String::new());
     match &args.out {
         Some(path) => {
             crate::io::write_atomic(path, csv.as_bytes())?;

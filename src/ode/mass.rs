@@ -97,8 +97,7 @@ impl Mass {
         // Sylvester's criterion: leading principal minors all positive.
         let d1 = m[0][0];
         let d2 = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-        let d3 = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        let d3 = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
         if !(finite && symmetric && d1 > 0.0 && d2 > 0.0 && d3 > 0.0) {
             return Err(OdeError::invalid(

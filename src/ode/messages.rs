@@ -71,11 +71,7 @@ unsafe extern "C" fn sink(kind: c_int, errnum: c_int, text: *const c_char) {
         if recent.len() == RECENT_CAPACITY {
             recent.pop_front();
         }
-        recent.push_back(OdeMessage {
-            kind,
-            errnum,
-            text,
-        });
+        recent.push_back(OdeMessage { kind, errnum, text });
     }
 }
 

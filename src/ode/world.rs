@@ -99,7 +99,9 @@ impl World {
         // SAFETY: the world is live and dt > 0, which dWorldQuickStep asserts.
         let ok = unsafe { ode_sys::dWorldQuickStep(self.handle.id, dt) };
         if ok == 0 {
-            return Err(OdeError::CallFailed { call: "dWorldQuickStep" });
+            return Err(OdeError::CallFailed {
+                call: "dWorldQuickStep",
+            });
         }
         Ok(())
     }
@@ -120,12 +122,18 @@ impl World {
     /// Creates a Plane2D joint that holds `body` in the world's x-y plane.
     pub fn create_plane2d_joint(&self, body: &Body) -> Result<Joint, OdeError> {
         if !Rc::ptr_eq(&self.handle, &body._world) {
-            return Err(OdeError::invalid("body", "a body of another world", "must belong to this world"));
+            return Err(OdeError::invalid(
+                "body",
+                "a body of another world",
+                "must belong to this world",
+            ));
         }
         // SAFETY: the world is live; a null group means "no joint group".
         let id = unsafe { ode_sys::dJointCreatePlane2D(self.handle.id, std::ptr::null_mut()) };
         if id.is_null() {
-            return Err(OdeError::CallFailed { call: "dJointCreatePlane2D" });
+            return Err(OdeError::CallFailed {
+                call: "dJointCreatePlane2D",
+            });
         }
         // SAFETY: joint and body are live and belong to the same world; a
         // null second body attaches the joint to the static environment.

@@ -15,7 +15,10 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-pub use crosscheck::{crosscheck, random_thrust_sequence, tolerance, trajectory, BackendComparison, CrosscheckReport, Deviation, Tolerance};
+pub use crosscheck::{
+    crosscheck, random_thrust_sequence, tolerance, trajectory, BackendComparison, CrosscheckReport, Deviation,
+    Tolerance,
+};
 pub use model::{MassPart, MassProperties, RigidBodyModel, Thruster};
 pub use native::{NativeBackend, RotationRule};
 pub use ode_backend::OdeBackend;
@@ -73,7 +76,9 @@ impl BodyState {
         if values.iter().all(|v| v.is_finite()) {
             Ok(())
         } else {
-            Err(PhysicsError::InvalidState(format!("every component must be finite, got {self:?}")))
+            Err(PhysicsError::InvalidState(format!(
+                "every component must be finite, got {self:?}"
+            )))
         }
     }
 }
@@ -153,13 +158,20 @@ impl StepSettings {
     /// Rejects values no backend can run with.
     pub fn validate(&self) -> Result<(), PhysicsError> {
         if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(PhysicsError::InvalidSetting(format!("time step dt must be finite and > 0, got {}", self.dt)));
+            return Err(PhysicsError::InvalidSetting(format!(
+                "time step dt must be finite and > 0, got {}",
+                self.dt
+            )));
         }
         if self.quick_step_iterations == 0 {
-            return Err(PhysicsError::InvalidSetting("quick_step_iterations must be >= 1, got 0".into()));
+            return Err(PhysicsError::InvalidSetting(
+                "quick_step_iterations must be >= 1, got 0".into(),
+            ));
         }
         if self.rapier_solver_iterations == 0 {
-            return Err(PhysicsError::InvalidSetting("rapier_solver_iterations must be >= 1, got 0".into()));
+            return Err(PhysicsError::InvalidSetting(
+                "rapier_solver_iterations must be >= 1, got 0".into(),
+            ));
         }
         Ok(())
     }
@@ -242,7 +254,9 @@ pub fn validate_thrust(thrust: &[f64], thrusters: usize) -> Result<(), PhysicsEr
     }
     for (i, &u) in thrust.iter().enumerate() {
         if !(0.0..=1.0).contains(&u) {
-            return Err(PhysicsError::InvalidThrust(format!("thruster {i}: {u} is not a number in [0, 1]")));
+            return Err(PhysicsError::InvalidThrust(format!(
+                "thruster {i}: {u} is not a number in [0, 1]"
+            )));
         }
     }
     Ok(())

@@ -65,7 +65,9 @@ fn positive(what: &str, value: f64) -> Result<(), PhysicsError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(PhysicsError::InvalidModel(format!("{what} must be finite and > 0, got {value}")))
+        Err(PhysicsError::InvalidModel(format!(
+            "{what} must be finite and > 0, got {value}"
+        )))
     }
 }
 
@@ -115,9 +117,16 @@ impl RigidBodyModel {
                 MassPart::Cylinder { radius, height, center } => {
                     let m = self.density * std::f64::consts::PI * radius * radius * height;
                     let side = m * (0.25 * radius * radius + height * height / 12.0);
-                    (m, Matrix3::from_diagonal(&Vector3::new(side, side, 0.5 * m * radius * radius)), center)
+                    (
+                        m,
+                        Matrix3::from_diagonal(&Vector3::new(side, side, 0.5 * m * radius * radius)),
+                        center,
+                    )
                 }
-                MassPart::Cuboid { size: [lx, ly, lz], center } => {
+                MassPart::Cuboid {
+                    size: [lx, ly, lz],
+                    center,
+                } => {
                     let m = self.density * lx * ly * lz;
                     let d = Vector3::new(ly * ly + lz * lz, lx * lx + lz * lz, lx * lx + ly * ly) * (m / 12.0);
                     (m, Matrix3::from_diagonal(&d), center)

@@ -11,8 +11,8 @@
 //! planar spin about a principal axis, as here.
 
 use super::{
-    validate_thrust, wrap_angle, BackendKind, BodyState, MassProperties, PhysicsBackend, PhysicsError,
-    RigidBodyModel, StepSettings,
+    validate_thrust, wrap_angle, BackendKind, BodyState, MassProperties, PhysicsBackend, PhysicsError, RigidBodyModel,
+    StepSettings,
 };
 
 /// How the heading advances in one step of angular velocity w.

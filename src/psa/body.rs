@@ -53,14 +53,23 @@ impl BodySettings {
         let r = self.mount_radius;
         let [length, width, height] = self.thruster_size;
         // (mount, thrust direction); boxes lie with their length along the thrust.
-        let layout = [([0.0, -r], [1.0, 0.0]), ([r, 0.0], [0.0, 1.0]), ([0.0, r], [1.0, 0.0]), ([-r, 0.0], [0.0, 1.0])];
+        let layout = [
+            ([0.0, -r], [1.0, 0.0]),
+            ([r, 0.0], [0.0, 1.0]),
+            ([0.0, r], [1.0, 0.0]),
+            ([-r, 0.0], [0.0, 1.0]),
+        ];
         let mut parts = vec![MassPart::Cylinder {
             radius: self.hull_radius,
             height: self.hull_height,
             center: [0.0, 0.0],
         }];
         parts.extend(layout.iter().map(|&(mount, dir)| MassPart::Cuboid {
-            size: if dir[0] != 0.0 { [length, width, height] } else { [width, length, height] },
+            size: if dir[0] != 0.0 {
+                [length, width, height]
+            } else {
+                [width, length, height]
+            },
             center: mount,
         }));
         let model = RigidBodyModel {

@@ -11,7 +11,7 @@
 //!   "input_scaling": { "position_scale": 10.0, ... },
 //!   "task": 1,
 //!   "neurons": [ { "weights": [11 numbers: 7 input weights (bias last), 4 output weights], "lesioned": false }, ... ],
-//!   "provenance": { "tool_version": "...", "git_commit": "...", "libode_version": "...", "created": "...", ... }
+//!   "provenance": { "tool_version": "...", "git_commit": "...", "libode_version": "...", ... }
 //! }
 //! ```
 
@@ -88,8 +88,9 @@ pub struct NetworkFile {
 }
 
 impl NetworkFile {
-    /// A file for `network`, stamped with this build and the current time;
-    /// `extra` adds provenance fields.
+    /// A file for `network`, stamped with this build (tool version, git
+    /// commit, libode version); `extra` adds provenance fields. No time
+    /// stamp, so that the same run always writes the same bytes.
     pub fn new(
         network: &Network,
         task: Task,
@@ -101,7 +102,6 @@ impl NetworkFile {
         provenance.insert("tool_version".into(), build.tool_version.into());
         provenance.insert("git_commit".into(), build.git_commit.into());
         provenance.insert("libode_version".into(), build.libode_version.into());
-        provenance.insert("created".into(), crate::provenance::now_rfc3339().into());
         provenance.extend(extra);
         NetworkFile {
             format: FORMAT.into(),
@@ -128,7 +128,11 @@ impl NetworkFile {
     pub fn network(&self) -> Result<Network, String> {
         let t = self.topology;
         if self.neurons.len() != t.hidden {
-            return Err(format!("topology says {} hidden neurons, the file has {}", t.hidden, self.neurons.len()));
+            return Err(format!(
+                "topology says {} hidden neurons, the file has {}",
+                t.hidden,
+                self.neurons.len()
+            ));
         }
         let weights: Vec<Vec<f64>> = self.neurons.iter().map(|n| n.weights.clone()).collect();
         let mut network = Network::from_neurons(t.inputs, t.outputs, &weights).map_err(|e| e.to_string())?;
@@ -157,12 +161,15 @@ impl NetworkFile {
             problem,
         };
         let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read it: {e}")))?;
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| fail(format!("not valid JSON: {e}")))?;
+        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| fail(format!("not valid JSON: {e}")))?;
         match value.get("format").and_then(|f| f.as_str()) {
             Some(FORMAT) => {}
             Some(other) => return Err(fail(format!("format is {other:?}, expected {FORMAT:?}"))),
-            None => return Err(fail(format!("no \"format\": {FORMAT:?} field; not a psa-esp network file"))),
+            None => {
+                return Err(fail(format!(
+                    "no \"format\": {FORMAT:?} field; not a psa-esp network file"
+                )))
+            }
         }
         match value.get("version").and_then(|v| v.as_u64()) {
             Some(v) if v == VERSION as u64 => {}
@@ -173,7 +180,10 @@ impl NetworkFile {
         }
         let file: NetworkFile = serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;
         if file.activation != ACTIVATION {
-            return Err(fail(format!("activation {:?} is not supported (only {ACTIVATION:?})", file.activation)));
+            return Err(fail(format!(
+                "activation {:?} is not supported (only {ACTIVATION:?})",
+                file.activation
+            )));
         }
         let network = file.network().map_err(fail)?;
         Ok((file, network))

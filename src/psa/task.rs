@@ -57,7 +57,10 @@ impl From<Task> for u8 {
 impl std::str::FromStr for Task {
     type Err = String;
     fn from_str(s: &str) -> Result<Task, String> {
-        let n: u8 = s.trim().parse().map_err(|_| format!("task must be 1, 2 or 3, got {s:?}"))?;
+        let n: u8 = s
+            .trim()
+            .parse()
+            .map_err(|_| format!("task must be 1, 2 or 3, got {s:?}"))?;
         Task::try_from(n)
     }
 }
@@ -125,7 +128,9 @@ impl TaskSettings {
         }
         let [lo, hi] = self.task3_random_distance;
         if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
-            return Err(format!("tasks.task3_random_distance must be a finite range [low, high], got [{lo}, {hi}]"));
+            return Err(format!(
+                "tasks.task3_random_distance must be a finite range [low, high], got [{lo}, {hi}]"
+            ));
         }
         Ok(())
     }
@@ -138,7 +143,11 @@ impl TaskSettings {
         match task {
             Task::StopRotation => {
                 // PI - u * TAU with u in [0, 1) is uniform in (-pi, pi].
-                let heading = if random_init { PI - rng.random::<f64>() * TAU } else { 0.0 };
+                let heading = if random_init {
+                    PI - rng.random::<f64>() * TAU
+                } else {
+                    0.0
+                };
                 (
                     BodyState {
                         heading,
@@ -157,7 +166,11 @@ impl TaskSettings {
             ),
             Task::StopAtPosition => {
                 let [lo, hi] = self.task3_random_distance;
-                let distance = if random_init { lo + rng.random::<f64>() * (hi - lo) } else { self.task3_distance };
+                let distance = if random_init {
+                    lo + rng.random::<f64>() * (hi - lo)
+                } else {
+                    self.task3_distance
+                };
                 (
                     BodyState {
                         vy: self.task3_speed,

@@ -118,7 +118,9 @@ impl TrialRunner {
     pub fn new(settings: &PsaSettings, task: Task) -> Result<TrialRunner, PsaError> {
         settings.validate()?;
         if settings.random_init && !task.has_random_init() {
-            return Err(PsaError::Setting(format!("task {task} has no random-initialisation variant")));
+            return Err(PsaError::Setting(format!(
+                "task {task} has no random-initialisation variant"
+            )));
         }
         let model = settings.body.model()?;
         let backend = create_backend(settings.backend, &model, &settings.physics)?;

@@ -1,0 +1,175 @@
+//! `psa-esp replay`: fly a saved network on a task and show what it does.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+
+use crate::physics::BackendKind;
+use crate::plots::{write_trial_pictures, TrialPicture};
+use crate::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
+
+/// Key of the random stream of replays.
+const REPLAY_STREAM: u64 = 0x7265_706c_6179; // "replay"
+
+/// Arguments of `replay`.
+#[derive(Debug, clap::Args)]
+pub struct ReplayArgs {
+    /// The network file (JSON) to fly.
+    pub network: PathBuf,
+    /// Task 1, 2 or 3 (default: the task the network was evolved for).
+    #[arg(long)]
+    pub task: Option<Task>,
+    /// Physics backend.
+    #[arg(long, value_enum, default_value_t = BackendKind::Ode)]
+    pub backend: BackendKind,
+    /// Standard deviation of Gaussian noise on every input but the bias.
+    #[arg(long, default_value_t = 0.0)]
+    pub input_noise: f64,
+    /// Standard deviation of Gaussian noise on every output (before clamping).
+    #[arg(long, default_value_t = 0.0)]
+    pub output_noise: f64,
+    /// Random initial conditions (tasks 1 and 3).
+    #[arg(long)]
+    pub random_init: bool,
+    /// Number of trials; the fitness is their mean.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub trials: u64,
+    /// Seed of the noise and random initial conditions.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print the result as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Where to write the first trial's trajectory, pictures and animation
+    /// (default: replay-<network name>-task<N> in the current directory).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// What `replay --json` prints.
+#[derive(Debug, Serialize)]
+struct ReplaySummary {
+    network: PathBuf,
+    task: Task,
+    backend: BackendKind,
+    trials: u64,
+    seed: u64,
+    input_noise: f64,
+    output_noise: f64,
+    random_init: bool,
+    fitness_percent_mean: f64,
+    fitness_percent_sd: f64,
+    fitness_percent_per_trial: Vec<f64>,
+    files: Vec<PathBuf>,
+}
+
+fn mean_and_sd(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    if values.len() < 2 {
+        return (mean, 0.0);
+    }
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, var.sqrt())
+}
+
+fn write_outputs(dir: &Path, record: &TrialRecord, settings: &PsaSettings, title: String) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
+    let csv = super::trajectory_csv(&record.states, settings.physics.dt, ",u0,u1,u2,u3,points", |i| {
+        match (
+            i.checked_sub(1).and_then(|k| record.outputs.get(k)),
+            i.checked_sub(1).and_then(|k| record.points.get(k)),
+        ) {
+            (Some(u), Some(p)) => format!(",{},{},{},{},{p}", u[0], u[1], u[2], u[3]),
+            _ => ",,,,,".into(),
+        }
+    });
+    let csv_path = dir.join("trajectory.csv");
+    crate::io::write_atomic(&csv_path, csv.as_bytes())?;
+    let picture = TrialPicture {
+        title,
+        dt: settings.physics.dt,
+        states: &record.states,
+        outputs: &record.outputs,
+        target: [record.target.x, record.target.y, record.target.heading],
+        box_half_width: settings.fitness.box_half_width,
+        heading_window: settings.fitness.heading_window,
+        hull_radius: settings.body.hull_radius,
+    };
+    let mut files = vec![csv_path];
+    files.extend(write_trial_pictures(&picture, dir, "trial")?);
+    Ok(files)
+}
+
+/// Runs `replay`.
+pub fn run(args: ReplayArgs) -> Result<i32> {
+    let (file, network) = NetworkFile::load(&args.network)?;
+    let task = args.task.unwrap_or(file.task);
+    if args.random_init && !task.has_random_init() {
+        bail!("--random-init: task {task} has no random-initialisation variant (tasks 1 and 3 have)");
+    }
+    let settings = PsaSettings {
+        backend: args.backend,
+        trials: args.trials as usize,
+        random_init: args.random_init,
+        sensors: file.input_scaling,
+        noise: NoiseSettings {
+            input_sd: args.input_noise,
+            output_sd: args.output_noise,
+        },
+        ..PsaSettings::default()
+    };
+    let mut runner = TrialRunner::new(&settings, task)?;
+    let mut rng = crate::rng::stream(args.seed, &[REPLAY_STREAM]);
+    let maximum = runner.maximum_points();
+    let mut first = TrialRecord::default();
+    let mut per_trial = Vec::with_capacity(settings.trials);
+    for trial in 0..settings.trials {
+        let record = (trial == 0).then_some(&mut first);
+        per_trial.push(100.0 * runner.run_trial(&network, &mut rng, record)? / maximum);
+    }
+    let (mean, sd) = mean_and_sd(&per_trial);
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = args
+            .network
+            .file_stem()
+            .map_or("network".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from(format!("replay-{stem}-task{task}"))
+    });
+    let title = format!(
+        "{} on task {task} ({} backend): trial 1 scores {:.1} %",
+        args.network
+            .file_name()
+            .map_or("network".into(), |s| s.to_string_lossy()),
+        args.backend,
+        per_trial[0]
+    );
+    let files = write_outputs(&out, &first, &settings, title)?;
+    if args.json {
+        let summary = ReplaySummary {
+            network: args.network,
+            task,
+            backend: args.backend,
+            trials: args.trials,
+            seed: args.seed,
+            input_noise: args.input_noise,
+            output_noise: args.output_noise,
+            random_init: args.random_init,
+            fitness_percent_mean: mean,
+            fitness_percent_sd: sd,
+            fitness_percent_per_trial: per_trial,
+            files,
+        };
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        println!(
+            "task {task}, {} backend, {} trial(s): fitness {mean:.2} % (sd {sd:.2}) of the theoretical maximum",
+            args.backend, args.trials
+        );
+        for f in &files {
+            println!("wrote {}", f.display());
+        }
+    }
+    Ok(0)
+}

@@ -1,0 +1,780 @@
+//! Enforced Sub-Populations (Gomez & Miikkulainen), with Høverstad's
+//! modifications as switches (`algorithms.md` §1-2).
+
+use anyhow::{anyhow, Result};
+use rand::seq::SliceRandom;
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+use super::operators::{cauchy, crossover, mutate_one_gene, random_genes};
+use super::{check_count, check_positive, check_probability, evaluate_all, purpose};
+use super::{Champion, Evaluator, GenerationRecord, LesionOutcome, RunResult};
+use crate::network::Network;
+use crate::rng::stream;
+
+/// How networks are formed from the sub-populations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampling {
+    /// Each network takes a uniformly random neuron from every sub-population. [paper, ESP]
+    Random,
+    /// Høverstad's: per round, shuffle every sub-population and build network
+    /// k from the k-th neurons; every neuron is evaluated exactly
+    /// `trials_per_neuron` times. (Table 4)
+    Systematic,
+}
+
+/// How a neuron's fitness is derived from its networks'.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Credit {
+    /// The mean fitness of the networks it took part in. [paper, ESP]
+    Mean,
+    /// The highest. (Table 5)
+    Max,
+}
+
+/// What burst mutation does with the sub-populations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BurstMode {
+    /// Høverstad's default: discard all sub-populations, rebuild one per
+    /// neuron of the best network, then apply a pending topology change
+    /// again (lesion test, add or remove).
+    DiscardAll,
+    /// Gomez's original: rebuild the sub-populations of the best network's
+    /// neurons; sub-populations added since it was found persist untouched.
+    Gomez,
+}
+
+/// Whether lesion tests change the topology.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TopologyMode {
+    /// Lesion tests add or remove sub-populations. [paper]
+    Lesion,
+    /// No lesion tests, no topology change. (Table 6)
+    Off,
+}
+
+/// Every setting of ESP; defaults are the paper's baseline (Table 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EspSettings {
+    /// Neurons per sub-population. [paper] 40
+    pub subpop_size: usize,
+    /// Networks per generation = this x `subpop_size`. [paper] 10
+    pub trials_per_neuron: usize,
+    /// Sub-populations (hidden neurons) at the start. [paper] 5
+    pub initial_hidden: usize,
+    /// Generations. [paper] 2000
+    pub generations: usize,
+    /// Initial weights are uniform in (-range, range). [paper] 6
+    pub init_range: f64,
+    /// Network formation. [paper] random
+    pub sampling: Sampling,
+    /// Neuron credit. [paper] mean
+    pub credit: Credit,
+    /// Probability that a child gets Cauchy noise on one gene. [paper] 0.4
+    pub mutation_rate: f64,
+    /// Scale of that Cauchy noise. [paper] 0.3
+    pub mutation_scale: f64,
+    /// Cauchy draws larger than this in magnitude are drawn again. [paper] 10
+    pub cauchy_limit: f64,
+    /// Generations without improvement of the best network before a burst mutation (b). [paper] 20
+    pub stagnation: usize,
+    /// Scale of the Cauchy noise of burst mutation, on every gene. [paper] 0.3
+    pub burst_scale: f64,
+    /// Burst mutation's form. [paper, Høverstad] discard_all
+    pub burst: BurstMode,
+    /// Lesion tests after `bursts_before_lesion` fruitless burst mutations. [paper] lesion
+    pub topology: TopologyMode,
+    /// Burst mutations without improvement that trigger a lesion test. [paper] 2
+    pub bursts_before_lesion: usize,
+    /// A neuron is redundant when the network without it keeps this share of the fitness. [chosen] 0.9
+    pub lesion_threshold: f64,
+    /// Forget the search's best network whenever a sub-population is added or removed. (Table 6) [paper] false
+    pub erase_best: bool,
+}
+
+impl Default for EspSettings {
+    fn default() -> Self {
+        EspSettings {
+            subpop_size: 40,
+            trials_per_neuron: 10,
+            initial_hidden: 5,
+            generations: 2000,
+            init_range: 6.0,
+            sampling: Sampling::Random,
+            credit: Credit::Mean,
+            mutation_rate: 0.4,
+            mutation_scale: 0.3,
+            cauchy_limit: 10.0,
+            stagnation: 20,
+            burst_scale: 0.3,
+            burst: BurstMode::DiscardAll,
+            topology: TopologyMode::Lesion,
+            bursts_before_lesion: 2,
+            lesion_threshold: 0.9,
+            erase_best: false,
+        }
+    }
+}
+
+impl EspSettings {
+    /// Rejects out-of-range values, naming the setting.
+    pub fn validate(&self) -> Result<(), String> {
+        check_count("esp.subpop_size", self.subpop_size, 4)?;
+        check_count("esp.trials_per_neuron", self.trials_per_neuron, 1)?;
+        check_count("esp.initial_hidden", self.initial_hidden, 1)?;
+        check_count("esp.generations", self.generations, 1)?;
+        check_count("esp.stagnation", self.stagnation, 1)?;
+        check_count("esp.bursts_before_lesion", self.bursts_before_lesion, 1)?;
+        check_positive("esp.init_range", self.init_range)?;
+        check_positive("esp.mutation_scale", self.mutation_scale)?;
+        check_positive("esp.cauchy_limit", self.cauchy_limit)?;
+        check_positive("esp.burst_scale", self.burst_scale)?;
+        check_probability("esp.mutation_rate", self.mutation_rate)?;
+        check_probability("esp.lesion_threshold", self.lesion_threshold)?;
+        Ok(())
+    }
+
+    /// Networks evaluated per generation (lesion tests not counted).
+    pub fn networks_per_generation(&self) -> usize {
+        self.trials_per_neuron * self.subpop_size
+    }
+}
+
+/// An ESP run: settings and seed.
+#[derive(Debug, Clone)]
+pub struct Esp {
+    settings: EspSettings,
+    seed: u64,
+}
+
+/// The search's state between generations.
+struct State {
+    inputs: usize,
+    outputs: usize,
+    /// `subpops[i][k]`: neuron k of sub-population i (its genes).
+    subpops: Vec<Vec<Vec<f64>>>,
+    /// The search's best network and its fitness (what burst mutation builds on).
+    best: Option<(Network, f64)>,
+    champion: Option<Champion>,
+    since_improvement: usize,
+    bursts_since_improvement: usize,
+    /// Discard-all: the topology change to apply again after each burst.
+    pending: Option<LesionOutcome>,
+    bursts: usize,
+    evaluations: u64,
+}
+
+impl Esp {
+    /// An ESP run with `settings` and `seed`; fails on invalid settings.
+    pub fn new(settings: EspSettings, seed: u64) -> Result<Esp, String> {
+        settings.validate()?;
+        Ok(Esp { settings, seed })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &EspSettings {
+        &self.settings
+    }
+
+    /// Runs all generations on the current rayon pool, calling
+    /// `on_generation` after each.
+    pub fn run<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        mut on_generation: impl FnMut(&GenerationRecord),
+    ) -> Result<RunResult> {
+        let s = &self.settings;
+        let (inputs, outputs) = (evaluator.inputs(), evaluator.outputs());
+        let genes = inputs + outputs;
+        let mut rng = stream(self.seed, &[purpose::INIT]);
+        let mut state = State {
+            inputs,
+            outputs,
+            subpops: (0..s.initial_hidden)
+                .map(|_| {
+                    (0..s.subpop_size)
+                        .map(|_| random_genes(&mut rng, genes, s.init_range))
+                        .collect()
+                })
+                .collect(),
+            best: None,
+            champion: None,
+            since_improvement: 0,
+            bursts_since_improvement: 0,
+            pending: None,
+            bursts: 0,
+            evaluations: 0,
+        };
+        let mut records = Vec::with_capacity(s.generations);
+        for generation in 1..=s.generations {
+            let record = self.generation(evaluator, &mut state, generation)?;
+            on_generation(&record);
+            records.push(record);
+        }
+        let champion = state.champion.ok_or_else(|| anyhow!("no network was evaluated"))?;
+        Ok(RunResult { champion, records })
+    }
+
+    /// Which neuron of each sub-population every network takes.
+    fn sample(&self, generation: usize, subpops: usize) -> Vec<Vec<usize>> {
+        let s = &self.settings;
+        let n = s.subpop_size;
+        let mut rng = stream(self.seed, &[purpose::SAMPLE, generation as u64]);
+        match s.sampling {
+            Sampling::Random => (0..s.networks_per_generation())
+                .map(|_| (0..subpops).map(|_| rng.random_range(0..n)).collect())
+                .collect(),
+            Sampling::Systematic => {
+                let mut picks = Vec::with_capacity(s.networks_per_generation());
+                for _ in 0..s.trials_per_neuron {
+                    let orders: Vec<Vec<usize>> = (0..subpops)
+                        .map(|_| {
+                            let mut order: Vec<usize> = (0..n).collect();
+                            order.shuffle(&mut rng);
+                            order
+                        })
+                        .collect();
+                    picks.extend((0..n).map(|k| orders.iter().map(|order| order[k]).collect()));
+                }
+                picks
+            }
+        }
+    }
+
+    fn generation<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        generation: usize,
+    ) -> Result<GenerationRecord> {
+        let s = &self.settings;
+        let picks = self.sample(generation, state.subpops.len());
+        let networks = picks
+            .iter()
+            .map(|pick| {
+                let genes: Vec<f64> = pick
+                    .iter()
+                    .zip(&state.subpops)
+                    .flat_map(|(&k, sp)| sp[k].iter().copied())
+                    .collect();
+                Network::from_genes(state.inputs, state.outputs, genes)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let fitness = evaluate_all(evaluator, &networks, self.seed, &[purpose::EVALUATE, generation as u64])?;
+        state.evaluations += networks.len() as u64;
+
+        // The generation's best network updates the champion and the search's best.
+        let (top, &top_fitness) =
+            fitness.iter().enumerate().fold(
+                (0, &f64::NEG_INFINITY),
+                |acc, (j, f)| if *f > *acc.1 { (j, f) } else { acc },
+            );
+        if state.champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
+            state.champion = Some(Champion {
+                network: networks[top].clone(),
+                fitness: top_fitness,
+                generation,
+            });
+        }
+        let improved = state.best.as_ref().is_none_or(|(_, f)| top_fitness > *f);
+        if improved {
+            state.best = Some((networks[top].clone(), top_fitness));
+            state.since_improvement = 0;
+            state.bursts_since_improvement = 0;
+            state.pending = None;
+        } else {
+            state.since_improvement += 1;
+        }
+
+        let mut burst = false;
+        let mut lesion = None;
+        if state.since_improvement >= s.stagnation {
+            state.since_improvement = 0;
+            burst = true;
+            lesion = self.stagnate(evaluator, state, generation)?;
+        } else {
+            self.assign_credit(state, &picks, &fitness);
+            for (i, subpop) in state.subpops.iter_mut().enumerate() {
+                self.recombine(subpop, generation, i);
+            }
+        }
+        let n = fitness.len() as f64;
+        Ok(GenerationRecord {
+            generation,
+            min: fitness.iter().copied().fold(f64::INFINITY, f64::min),
+            mean: fitness.iter().sum::<f64>() / n,
+            max: top_fitness,
+            best: state.best.as_ref().map(|(_, f)| *f),
+            champion: state.champion.as_ref().map_or(f64::NAN, |c| c.fitness),
+            evaluations: state.evaluations,
+            subpops: state.subpops.len(),
+            burst,
+            bursts: state.bursts,
+            lesion,
+        })
+    }
+
+    /// Neuron fitness from the networks' (0 for a neuron in no network),
+    /// then each sub-population sorted best first (stable).
+    fn assign_credit(&self, state: &mut State, picks: &[Vec<usize>], fitness: &[f64]) {
+        let n = self.settings.subpop_size;
+        for (i, subpop) in state.subpops.iter_mut().enumerate() {
+            let mut sum = vec![0.0; n];
+            let mut count = vec![0usize; n];
+            let mut max = vec![f64::NEG_INFINITY; n];
+            for (pick, &f) in picks.iter().zip(fitness) {
+                let k = pick[i];
+                sum[k] += f;
+                count[k] += 1;
+                max[k] = max[k].max(f);
+            }
+            let credit: Vec<f64> = (0..n)
+                .map(|k| match (count[k], self.settings.credit) {
+                    (0, _) => 0.0,
+                    (c, Credit::Mean) => sum[k] / c as f64,
+                    (_, Credit::Max) => max[k],
+                })
+                .collect();
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by(|&a, &b| credit[b].total_cmp(&credit[a]));
+            *subpop = order.into_iter().map(|k| std::mem::take(&mut subpop[k])).collect();
+        }
+    }
+
+    /// Crossover of the top quarter into the bottom half, then mutation of
+    /// the children (`subpop` sorted best first).
+    fn recombine(&self, subpop: &mut [Vec<f64>], generation: usize, index: usize) {
+        let s = &self.settings;
+        let n = subpop.len();
+        let breeders = n / 4;
+        let mut rng = stream(self.seed, &[purpose::BREED, generation as u64, index as u64]);
+        let genes = subpop[0].len();
+        let (mut first, mut second) = (vec![0.0; genes], vec![0.0; genes]);
+        for i in 0..breeders {
+            // The best mates with any of the top quarter, the others with a higher-ranked one.
+            let mate = if i == 0 {
+                rng.random_range(0..breeders)
+            } else {
+                rng.random_range(0..i)
+            };
+            crossover(&mut rng, &subpop[i], &subpop[mate], &mut first, &mut second);
+            subpop[n - 1 - 2 * i].copy_from_slice(&first);
+            subpop[n - 2 - 2 * i].copy_from_slice(&second);
+        }
+        for child in &mut subpop[n - 2 * breeders..] {
+            mutate_one_gene(&mut rng, child, s.mutation_rate, s.mutation_scale, s.cauchy_limit);
+        }
+    }
+
+    /// Stagnation: a lesion test when bursts have failed often enough, and a
+    /// burst mutation. Returns the lesion outcome applied, if any.
+    fn stagnate<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        generation: usize,
+    ) -> Result<Option<LesionOutcome>> {
+        let s = &self.settings;
+        let lesion_on = s.topology == TopologyMode::Lesion;
+        let mut outcome = None;
+        if lesion_on && state.bursts_since_improvement >= s.bursts_before_lesion {
+            state.bursts_since_improvement = 0;
+            outcome = Some(self.lesion_test(evaluator, state, generation)?);
+        }
+        let (best, _) = state
+            .best
+            .clone()
+            .ok_or_else(|| anyhow!("burst mutation without a best network"))?;
+        let mut rng = stream(self.seed, &[purpose::BURST, generation as u64]);
+        match s.burst {
+            BurstMode::Gomez => {
+                if let Some(change) = outcome {
+                    self.apply_change(state, change, generation, true);
+                }
+                let best = state.best.as_ref().map_or(best, |(b, _)| b.clone());
+                for k in 0..best.hidden() {
+                    state.subpops[k] = self.around(best.neuron(k), &mut rng);
+                }
+            }
+            BurstMode::DiscardAll => {
+                state.subpops = (0..best.hidden())
+                    .map(|k| self.around(best.neuron(k), &mut rng))
+                    .collect();
+                if outcome.is_none() && lesion_on && state.pending.is_some() {
+                    // The pending change is decided again by a new lesion test.
+                    outcome = Some(self.lesion_test(evaluator, state, generation)?);
+                }
+                if let Some(change) = outcome {
+                    state.pending = Some(change);
+                    self.apply_change(state, change, generation, false);
+                }
+            }
+        }
+        if outcome.is_some() && s.erase_best {
+            state.best = None;
+        }
+        state.bursts += 1;
+        state.bursts_since_improvement += 1;
+        Ok(outcome)
+    }
+
+    /// A sub-population of copies of `neuron`, Cauchy noise on every gene.
+    fn around(&self, neuron: &[f64], rng: &mut crate::rng::Stream) -> Vec<Vec<f64>> {
+        let s = &self.settings;
+        (0..s.subpop_size)
+            .map(|_| {
+                neuron
+                    .iter()
+                    .map(|w| w + cauchy(rng, s.burst_scale, s.cauchy_limit))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Evaluates the best network whole and with each hidden neuron
+    /// lesioned: a neuron is redundant when the network keeps
+    /// `lesion_threshold` of its fitness without it.
+    fn lesion_test<E: Evaluator>(&self, evaluator: &E, state: &mut State, generation: usize) -> Result<LesionOutcome> {
+        let (best, _) = state
+            .best
+            .as_ref()
+            .ok_or_else(|| anyhow!("lesion test without a best network"))?;
+        let mut variants = vec![best.clone()];
+        for k in 0..best.hidden() {
+            let mut lesioned = best.clone();
+            lesioned.set_lesioned(k, true);
+            variants.push(lesioned);
+        }
+        let fitness = evaluate_all(evaluator, &variants, self.seed, &[purpose::LESION, generation as u64])?;
+        state.evaluations += variants.len() as u64;
+        let whole = fitness[0];
+        let (neuron, kept) =
+            fitness[1..].iter().enumerate().fold(
+                (0, f64::NEG_INFINITY),
+                |acc, (k, &f)| if f > acc.1 { (k, f) } else { acc },
+            );
+        // For positive fitness this is kept >= threshold x whole.
+        let redundant = kept >= whole - (1.0 - self.settings.lesion_threshold) * whole.abs();
+        Ok(if best.hidden() > 1 && redundant {
+            LesionOutcome::Remove { neuron }
+        } else {
+            LesionOutcome::Add
+        })
+    }
+
+    /// Adds a sub-population of random neurons, or removes one. In Gomez's
+    /// form (`prune_best`) a removed neuron leaves the best network too.
+    fn apply_change(&self, state: &mut State, change: LesionOutcome, generation: usize, prune_best: bool) {
+        let s = &self.settings;
+        match change {
+            LesionOutcome::Add => {
+                let mut rng = stream(self.seed, &[purpose::NEW_SUBPOP, generation as u64]);
+                let genes = state.inputs + state.outputs;
+                state.subpops.push(
+                    (0..s.subpop_size)
+                        .map(|_| random_genes(&mut rng, genes, s.init_range))
+                        .collect(),
+                );
+            }
+            LesionOutcome::Remove { neuron } => {
+                state.subpops.remove(neuron);
+                if prune_best {
+                    if let Some((best, _)) = &mut state.best {
+                        let kept: Vec<Vec<f64>> = (0..best.hidden())
+                            .filter(|&k| k != neuron)
+                            .map(|k| best.neuron(k).to_vec())
+                            .collect();
+                        *best = Network::from_neurons(state.inputs, state.outputs, &kept)
+                            .expect("a network minus one of >= 2 neurons is valid");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evolution::FnEvaluator;
+
+    fn esp(settings: EspSettings) -> Esp {
+        Esp::new(settings, 11).unwrap()
+    }
+
+    /// A state of `hidden` sub-populations of 2-input, 1-output neurons.
+    fn state(e: &Esp, hidden: usize) -> State {
+        let mut rng = stream(5, &[]);
+        State {
+            inputs: 2,
+            outputs: 1,
+            subpops: (0..hidden)
+                .map(|_| {
+                    (0..e.settings.subpop_size)
+                        .map(|_| random_genes(&mut rng, 3, 6.0))
+                        .collect()
+                })
+                .collect(),
+            best: None,
+            champion: None,
+            since_improvement: 0,
+            bursts_since_improvement: 0,
+            pending: None,
+            bursts: 0,
+            evaluations: 0,
+        }
+    }
+
+    #[test]
+    fn children_of_rank_j_overwrite_ranks_n_1_2j_and_n_2_2j() {
+        let e = esp(EspSettings {
+            subpop_size: 12,
+            mutation_rate: 0.0,
+            ..EspSettings::default()
+        });
+        // Neuron k's genes all equal k: a child's genes show its parents.
+        let mut subpop: Vec<Vec<f64>> = (0..12).map(|k| vec![k as f64; 5]).collect();
+        e.recombine(&mut subpop, 1, 0);
+        for k in 0..6 {
+            assert_eq!(subpop[k], vec![k as f64; 5], "the top half survives unchanged");
+        }
+        for j in 0..3 {
+            let (first, second) = (&subpop[11 - 2 * j], &subpop[10 - 2 * j]);
+            // One-point crossover: the first child starts with parent j's
+            // genes up to the cut, the second with the mate's; the mate is
+            // higher ranked (or, for the best, any of the top quarter).
+            let mate = second[0];
+            let cut = first.iter().take_while(|g| **g == j as f64).count();
+            assert!(first[cut..].iter().all(|g| *g == mate), "{first:?}");
+            assert!(second[..cut].iter().all(|g| *g == mate) && second[cut..].iter().all(|g| *g == j as f64));
+            if j == 0 {
+                assert!(mate < 3.0);
+            } else {
+                assert!(mate < j as f64 || cut == 0, "mate {mate} of rank {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn only_children_are_mutated_at_the_configured_rate() {
+        let e = esp(EspSettings {
+            subpop_size: 40,
+            mutation_rate: 0.4,
+            ..EspSettings::default()
+        });
+        let mut mutated = 0;
+        for generation in 0..200 {
+            // All neurons identical: crossover changes nothing, so any change is a mutation.
+            let mut subpop = vec![vec![1.0; 11]; 40];
+            e.recombine(&mut subpop, generation, 0);
+            assert!(subpop[..20].iter().all(|n| *n == vec![1.0; 11]));
+            for child in &subpop[20..] {
+                let changed = child.iter().filter(|g| **g != 1.0).count();
+                assert!(changed <= 1, "one gene at most");
+                mutated += changed;
+            }
+        }
+        // 200 x 20 children x 0.4 = 1600, sd about 31.
+        assert!((1480..1720).contains(&mutated), "{mutated}");
+    }
+
+    #[test]
+    fn systematic_sampling_evaluates_every_neuron_exactly_ten_times() {
+        let e = esp(EspSettings {
+            sampling: Sampling::Systematic,
+            ..EspSettings::default()
+        });
+        let picks = e.sample(3, 5);
+        assert_eq!(picks.len(), 400);
+        for i in 0..5 {
+            let mut counts = [0; 40];
+            picks.iter().for_each(|p| counts[p[i]] += 1);
+            assert!(counts.iter().all(|&c| c == 10), "sub-population {i}: {counts:?}");
+        }
+        // Random sampling: 400 picks per sub-population, unevenly spread.
+        let random = esp(EspSettings::default()).sample(3, 5);
+        let mut counts = [0; 40];
+        random.iter().for_each(|p| counts[p[0]] += 1);
+        assert_eq!(counts.iter().sum::<usize>(), 400);
+        assert!(counts.iter().any(|&c| c != 10));
+    }
+
+    #[test]
+    fn credit_is_the_mean_or_the_max_of_the_networks_a_neuron_joined() {
+        for (credit, expected_best) in [(Credit::Mean, 2usize), (Credit::Max, 1usize)] {
+            let e = esp(EspSettings {
+                subpop_size: 4,
+                credit,
+                ..EspSettings::default()
+            });
+            let mut st = state(&e, 1);
+            st.subpops[0] = (0..4).map(|k| vec![k as f64; 3]).collect();
+            // Neuron 1: fitness 9 and 0 (mean 4.5, max 9); neuron 2: 5 and 5 (mean 5, max 5);
+            // neuron 0: 1; neuron 3: in no network (0).
+            let picks = vec![vec![1], vec![1], vec![2], vec![2], vec![0]];
+            e.assign_credit(&mut st, &picks, &[9.0, 0.0, 5.0, 5.0, 1.0]);
+            let order: Vec<f64> = st.subpops[0].iter().map(|n| n[0]).collect();
+            assert_eq!(order[0], expected_best as f64, "{credit:?}: {order:?}");
+            assert_eq!(order[3], 3.0, "{credit:?}: the unevaluated neuron ranks last");
+        }
+    }
+
+    /// Fitness 1 for a whole network, 0 with any neuron lesioned: never improves after the first generation.
+    fn all_neurons_needed() -> impl Evaluator<Worker = ()> {
+        FnEvaluator::new(2, 1, |n: &Network, _: &mut crate::rng::Stream| {
+            Ok(if (0..n.hidden()).any(|k| n.is_lesioned(k)) {
+                0.0
+            } else {
+                1.0
+            })
+        })
+    }
+
+    #[test]
+    fn burst_mutation_rebuilds_every_subpop_around_the_best_network() {
+        let e = esp(EspSettings {
+            topology: TopologyMode::Off,
+            ..EspSettings::default()
+        });
+        let mut st = state(&e, 3);
+        let best =
+            Network::from_neurons(2, 1, &[vec![1.0, 2.0, 3.0], vec![-1.0, 0.0, 1.0], vec![4.0, 4.0, 4.0]]).unwrap();
+        st.best = Some((best.clone(), 1.0));
+        e.stagnate(&all_neurons_needed(), &mut st, 1).unwrap();
+        assert_eq!(st.subpops.len(), 3);
+        assert_eq!(st.bursts, 1);
+        for (k, subpop) in st.subpops.iter().enumerate() {
+            let mut deltas: Vec<f64> = subpop
+                .iter()
+                .flat_map(|n| n.iter().zip(best.neuron(k)).map(|(a, b)| (a - b).abs()))
+                .collect();
+            assert!(
+                deltas.iter().all(|d| *d > 0.0 && *d <= 10.0),
+                "every gene perturbed, clipped"
+            );
+            deltas.sort_by(f64::total_cmp);
+            let median = deltas[deltas.len() / 2];
+            assert!(
+                (0.2..0.45).contains(&median),
+                "Cauchy scale 0.3: median |noise| {median}"
+            );
+        }
+    }
+
+    fn redundancy_evaluator() -> impl Evaluator<Worker = ()> {
+        // Fitness: the sum of gene 0 over the active hidden neurons.
+        FnEvaluator::new(2, 1, |n: &Network, _: &mut crate::rng::Stream| {
+            Ok((0..n.hidden())
+                .filter(|&k| !n.is_lesioned(k))
+                .map(|k| n.neuron(k)[0])
+                .sum())
+        })
+    }
+
+    #[test]
+    fn lesion_test_removes_a_redundant_neuron_and_adds_otherwise() {
+        let e = esp(EspSettings::default());
+        let mut st = state(&e, 3);
+        // Neuron 1 contributes 1 % of the fitness: redundant.
+        let net =
+            Network::from_neurons(2, 1, &[vec![5.0, 0.0, 0.0], vec![0.1, 0.0, 0.0], vec![4.9, 0.0, 0.0]]).unwrap();
+        st.best = Some((net, 10.0));
+        assert_eq!(
+            e.lesion_test(&redundancy_evaluator(), &mut st, 1).unwrap(),
+            LesionOutcome::Remove { neuron: 1 }
+        );
+        assert_eq!(st.evaluations, 4, "whole + 3 lesioned");
+        // Every neuron carries a third: none is redundant.
+        let net =
+            Network::from_neurons(2, 1, &[vec![1.0, 0.0, 0.0], vec![1.0, 0.0, 0.0], vec![1.0, 0.0, 0.0]]).unwrap();
+        st.best = Some((net, 3.0));
+        assert_eq!(
+            e.lesion_test(&redundancy_evaluator(), &mut st, 1).unwrap(),
+            LesionOutcome::Add
+        );
+        // Never below one hidden neuron.
+        let net = Network::from_neurons(2, 1, &[vec![0.0, 0.0, 0.0]]).unwrap();
+        st.best = Some((net, 0.0));
+        assert_eq!(
+            e.lesion_test(&redundancy_evaluator(), &mut st, 1).unwrap(),
+            LesionOutcome::Add
+        );
+    }
+
+    fn run_states(settings: EspSettings, generations: usize) -> Vec<(usize, Option<usize>, Option<LesionOutcome>)> {
+        let e = esp(EspSettings {
+            subpop_size: 8,
+            trials_per_neuron: 2,
+            stagnation: 3,
+            ..settings
+        });
+        let mut st = state(&e, 5);
+        let eval = all_neurons_needed();
+        (1..=generations)
+            .map(|g| {
+                let r = e.generation(&eval, &mut st, g).unwrap();
+                (st.subpops.len(), st.best.as_ref().map(|(b, _)| b.hidden()), r.lesion)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn discard_all_keeps_the_subpop_count_within_best_plus_or_minus_one() {
+        let states = run_states(EspSettings::default(), 120);
+        assert!(
+            states.iter().filter(|s| s.2.is_some()).count() >= 5,
+            "lesion tests happened"
+        );
+        for (subpops, best, _) in &states {
+            let best = best.unwrap();
+            assert!(
+                subpops.abs_diff(best) <= 1,
+                "{subpops} sub-populations, best has {best}"
+            );
+        }
+        assert!(states.iter().any(|s| s.0 == 6), "a sub-population was added");
+        // Gomez's form: failed lesion tests keep adding sub-populations.
+        let gomez = run_states(
+            EspSettings {
+                burst: BurstMode::Gomez,
+                ..EspSettings::default()
+            },
+            120,
+        );
+        let last = gomez.last().unwrap();
+        assert!(last.0 >= last.1.unwrap() + 3, "{last:?}");
+    }
+
+    #[test]
+    fn erase_best_forgets_the_best_on_a_topology_change_but_keeps_the_champion() {
+        let e = esp(EspSettings {
+            subpop_size: 8,
+            trials_per_neuron: 2,
+            stagnation: 3,
+            erase_best: true,
+            ..EspSettings::default()
+        });
+        let mut st = state(&e, 5);
+        let eval = all_neurons_needed();
+        let mut saw_erase = false;
+        for g in 1..=60 {
+            let r = e.generation(&eval, &mut st, g).unwrap();
+            if r.lesion.is_some() {
+                assert!(st.best.is_none(), "forgotten at the change");
+                assert_eq!(r.best, None);
+                saw_erase = true;
+                let champion = st.champion.as_ref().unwrap();
+                assert_eq!((champion.generation, champion.fitness), (1, 1.0), "the champion stays");
+            }
+            if let Some((b, _)) = &st.best {
+                assert_eq!(b.hidden(), st.subpops.len(), "the best always has the current size");
+            }
+        }
+        assert!(saw_erase);
+    }
+}

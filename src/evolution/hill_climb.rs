@@ -1,0 +1,310 @@
+//! Høverstad's parallel stochastic hill-climber (`algorithms.md` §3).
+
+use anyhow::{anyhow, Result};
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+use super::operators::{cauchy, random_genes};
+use super::{check_count, check_positive, check_probability, evaluate_all, purpose};
+use super::{Champion, Evaluator, GenerationRecord, RunResult};
+use crate::network::Network;
+use crate::rng::{stream, Stream};
+
+/// Every setting of the hill-climber ([chosen] defaults give it ESP's budget).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HillClimbSettings {
+    /// Hidden neurons of the network. [chosen] 5
+    pub hidden: usize,
+    /// Candidates per cycle (K). [chosen] 400
+    pub candidates: usize,
+    /// Cycles. [chosen] 2000
+    pub cycles: usize,
+    /// Initial weights are uniform in (-range, range). [paper] 6
+    pub init_range: f64,
+    /// Probability that a weight gets Cauchy noise. [chosen] 0.2
+    pub p_noise: f64,
+    /// Scale of that noise (alpha). [chosen] 1.0
+    pub alpha: f64,
+    /// Probability that a weight then changes sign. [chosen] 0.05
+    pub p_flip: f64,
+    /// p_noise is multiplied by this after every cycle. [chosen] 0.999
+    pub anneal_noise: f64,
+    /// alpha is multiplied by this after every cycle. [chosen] 0.999
+    pub anneal_alpha: f64,
+    /// p_flip is multiplied by this after every cycle. [chosen] 0.999
+    pub anneal_flip: f64,
+    /// Keep the base unless a candidate is at least as good (reported worse). [paper] false
+    pub elitist: bool,
+    /// Cauchy draws larger than this in magnitude are drawn again. [chosen] 10, as ESP
+    pub cauchy_limit: f64,
+}
+
+impl Default for HillClimbSettings {
+    fn default() -> Self {
+        HillClimbSettings {
+            hidden: 5,
+            candidates: 400,
+            cycles: 2000,
+            init_range: 6.0,
+            p_noise: 0.2,
+            alpha: 1.0,
+            p_flip: 0.05,
+            anneal_noise: 0.999,
+            anneal_alpha: 0.999,
+            anneal_flip: 0.999,
+            elitist: false,
+            cauchy_limit: 10.0,
+        }
+    }
+}
+
+impl HillClimbSettings {
+    /// Rejects out-of-range values, naming the setting.
+    pub fn validate(&self) -> Result<(), String> {
+        check_count("hill_climb.hidden", self.hidden, 1)?;
+        check_count("hill_climb.candidates", self.candidates, 1)?;
+        check_count("hill_climb.cycles", self.cycles, 1)?;
+        check_positive("hill_climb.init_range", self.init_range)?;
+        check_positive("hill_climb.alpha", self.alpha)?;
+        check_positive("hill_climb.cauchy_limit", self.cauchy_limit)?;
+        check_probability("hill_climb.p_noise", self.p_noise)?;
+        check_probability("hill_climb.p_flip", self.p_flip)?;
+        for (name, c) in [
+            ("hill_climb.anneal_noise", self.anneal_noise),
+            ("hill_climb.anneal_alpha", self.anneal_alpha),
+            ("hill_climb.anneal_flip", self.anneal_flip),
+        ] {
+            check_positive(name, c)?;
+        }
+        Ok(())
+    }
+}
+
+/// The mutation parameters of one cycle, after annealing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MutationRates {
+    /// Probability of Cauchy noise per weight.
+    pub p_noise: f64,
+    /// Its scale.
+    pub alpha: f64,
+    /// Probability of a sign change per weight.
+    pub p_flip: f64,
+}
+
+/// A hill-climbing run: settings and seed.
+#[derive(Debug, Clone)]
+pub struct HillClimb {
+    settings: HillClimbSettings,
+    seed: u64,
+}
+
+impl HillClimb {
+    /// A run with `settings` and `seed`; fails on invalid settings.
+    pub fn new(settings: HillClimbSettings, seed: u64) -> Result<HillClimb, String> {
+        settings.validate()?;
+        Ok(HillClimb { settings, seed })
+    }
+
+    /// The rates of cycle `cycle` (from 1): each initial rate times its
+    /// annealing constant to the power `cycle - 1`.
+    pub fn rates(&self, cycle: usize) -> MutationRates {
+        let s = &self.settings;
+        let k = (cycle - 1) as i32;
+        MutationRates {
+            p_noise: s.p_noise * s.anneal_noise.powi(k),
+            alpha: s.alpha * s.anneal_alpha.powi(k),
+            p_flip: (s.p_flip * s.anneal_flip.powi(k)).min(1.0),
+        }
+    }
+
+    /// Mutates every weight: Cauchy noise with probability `p_noise`, then a
+    /// sign change with probability `p_flip`.
+    pub fn mutate(&self, genes: &mut [f64], rates: MutationRates, rng: &mut Stream) {
+        for w in genes {
+            if rng.random::<f64>() < rates.p_noise {
+                *w += cauchy(rng, rates.alpha, self.settings.cauchy_limit);
+            }
+            if rng.random::<f64>() < rates.p_flip {
+                *w = -*w;
+            }
+        }
+    }
+
+    /// Runs all cycles on the current rayon pool, calling `on_cycle` after each.
+    pub fn run<E: Evaluator>(&self, evaluator: &E, mut on_cycle: impl FnMut(&GenerationRecord)) -> Result<RunResult> {
+        let s = &self.settings;
+        let (inputs, outputs) = (evaluator.inputs(), evaluator.outputs());
+        let mut rng = stream(self.seed, &[purpose::INIT]);
+        let mut base = Network::from_genes(
+            inputs,
+            outputs,
+            random_genes(&mut rng, s.hidden * (inputs + outputs), s.init_range),
+        )?;
+        let mut evaluations = 0u64;
+        // The base's fitness matters only to elitist acceptance.
+        let mut base_fitness = if s.elitist {
+            evaluations += 1;
+            evaluate_all(
+                evaluator,
+                std::slice::from_ref(&base),
+                self.seed,
+                &[purpose::EVALUATE, 0],
+            )?[0]
+        } else {
+            f64::NEG_INFINITY
+        };
+        let mut champion: Option<Champion> = None;
+        let mut records = Vec::with_capacity(s.cycles);
+        for cycle in 1..=s.cycles {
+            let rates = self.rates(cycle);
+            let candidates = (0..s.candidates)
+                .map(|j| {
+                    let mut genes = base.genes().to_vec();
+                    self.mutate(
+                        &mut genes,
+                        rates,
+                        &mut stream(self.seed, &[purpose::MUTATE, cycle as u64, j as u64]),
+                    );
+                    Network::from_genes(inputs, outputs, genes)
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let fitness = evaluate_all(evaluator, &candidates, self.seed, &[purpose::EVALUATE, cycle as u64])?;
+            evaluations += candidates.len() as u64;
+            let (top, top_fitness) =
+                fitness.iter().enumerate().fold(
+                    (0, f64::NEG_INFINITY),
+                    |acc, (j, &f)| if f > acc.1 { (j, f) } else { acc },
+                );
+            if champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
+                champion = Some(Champion {
+                    network: candidates[top].clone(),
+                    fitness: top_fitness,
+                    generation: cycle,
+                });
+            }
+            if !s.elitist || top_fitness >= base_fitness {
+                base = candidates[top].clone();
+                base_fitness = top_fitness;
+            }
+            let record = GenerationRecord {
+                generation: cycle,
+                min: fitness.iter().copied().fold(f64::INFINITY, f64::min),
+                mean: fitness.iter().sum::<f64>() / fitness.len() as f64,
+                max: top_fitness,
+                best: Some(base_fitness),
+                champion: champion.as_ref().map_or(f64::NAN, |c| c.fitness),
+                evaluations,
+                subpops: s.hidden,
+                burst: false,
+                bursts: 0,
+                lesion: None,
+            };
+            on_cycle(&record);
+            records.push(record);
+        }
+        let champion = champion.ok_or_else(|| anyhow!("no network was evaluated"))?;
+        Ok(RunResult { champion, records })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::evolution::FnEvaluator;
+
+    #[test]
+    fn noise_and_sign_flips_happen_at_the_configured_rates() {
+        let hc = HillClimb::new(HillClimbSettings::default(), 1).unwrap();
+        let rates = MutationRates {
+            p_noise: 0.2,
+            alpha: 1.0,
+            p_flip: 0.0,
+        };
+        let mut genes = vec![0.0; 50_000];
+        hc.mutate(&mut genes, rates, &mut stream(1, &[]));
+        let noisy = genes.iter().filter(|g| **g != 0.0).count();
+        assert!((9_600..10_400).contains(&noisy), "{noisy} of 50000, expected 10000");
+        let rates = MutationRates {
+            p_noise: 0.0,
+            alpha: 1.0,
+            p_flip: 0.05,
+        };
+        let mut genes = vec![1.0; 50_000];
+        hc.mutate(&mut genes, rates, &mut stream(2, &[]));
+        assert!(genes.iter().all(|g| g.abs() == 1.0), "a flip changes the sign only");
+        let flipped = genes.iter().filter(|g| **g < 0.0).count();
+        assert!((2_300..2_700).contains(&flipped), "{flipped} of 50000, expected 2500");
+    }
+
+    #[test]
+    fn each_rate_is_annealed_by_its_own_constant() {
+        let settings = HillClimbSettings {
+            anneal_noise: 0.9,
+            anneal_alpha: 0.5,
+            anneal_flip: 0.99,
+            ..HillClimbSettings::default()
+        };
+        let hc = HillClimb::new(settings, 1).unwrap();
+        assert_eq!(
+            hc.rates(1),
+            MutationRates {
+                p_noise: 0.2,
+                alpha: 1.0,
+                p_flip: 0.05
+            }
+        );
+        let r = hc.rates(11);
+        assert!((r.p_noise - 0.2 * 0.9f64.powi(10)).abs() < 1e-15);
+        assert!((r.alpha - 0.5f64.powi(10)).abs() < 1e-15);
+        assert!((r.p_flip - 0.05 * 0.99f64.powi(10)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn non_elitist_takes_the_best_candidate_even_when_worse_elitist_does_not() {
+        // Fitness is pure noise: the best candidate is often worse than the base.
+        let noise = FnEvaluator::new(2, 1, |_: &Network, rng: &mut Stream| Ok(rng.random::<f64>()));
+        let settings = HillClimbSettings {
+            candidates: 5,
+            cycles: 60,
+            ..HillClimbSettings::default()
+        };
+        let plain = HillClimb::new(settings.clone(), 3)
+            .unwrap()
+            .run(&noise, |_| {})
+            .unwrap();
+        for r in &plain.records {
+            assert_eq!(r.best, Some(r.max), "the base is always the cycle's best candidate");
+        }
+        assert!(
+            plain.records.windows(2).any(|w| w[1].best < w[0].best),
+            "it accepted a worse base"
+        );
+        let elitist = HillClimb::new(
+            HillClimbSettings {
+                elitist: true,
+                ..settings
+            },
+            3,
+        )
+        .unwrap()
+        .run(&noise, |_| {})
+        .unwrap();
+        assert!(
+            elitist.records.windows(2).all(|w| w[1].best >= w[0].best),
+            "never worse"
+        );
+        assert!(
+            elitist.records.iter().any(|r| r.best > Some(r.max)),
+            "kept the base over worse candidates"
+        );
+        assert_eq!(
+            elitist.records.last().unwrap().evaluations,
+            1 + 5 * 60,
+            "the base is evaluated once"
+        );
+        // The champion is the best network ever evaluated.
+        let top = plain.records.iter().map(|r| r.max).fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(plain.champion.fitness, top);
+    }
+}

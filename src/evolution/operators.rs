@@ -1,0 +1,122 @@
+//! The genetic operators of ESP and the hill-climber, as in the ESP code of
+//! Gomez & Miikkulainen.
+
+use rand::RngExt;
+
+use crate::rng::Stream;
+
+/// A Cauchy draw as in the ESP code: `alpha * tan(pi * u)`, `u` uniform in
+/// (0, 1), drawn again while its magnitude exceeds `limit`.
+pub fn cauchy(rng: &mut Stream, alpha: f64, limit: f64) -> f64 {
+    loop {
+        let u: f64 = rng.random();
+        if u == 0.0 {
+            continue;
+        }
+        let value = alpha * (std::f64::consts::PI * u).tan();
+        if value.abs() <= limit {
+            return value;
+        }
+    }
+}
+
+/// One-point crossover with the cut at `cut` (0 <= cut < len): the first
+/// child takes genes `[0, cut)` from `a` and the rest from `b`, the second
+/// child the other way round.
+pub fn crossover_at(a: &[f64], b: &[f64], cut: usize, first: &mut [f64], second: &mut [f64]) {
+    first[..cut].copy_from_slice(&a[..cut]);
+    first[cut..].copy_from_slice(&b[cut..]);
+    second[..cut].copy_from_slice(&b[..cut]);
+    second[cut..].copy_from_slice(&a[cut..]);
+}
+
+/// One-point crossover with the cut uniform over the genes.
+pub fn crossover(rng: &mut Stream, a: &[f64], b: &[f64], first: &mut [f64], second: &mut [f64]) {
+    let cut = rng.random_range(0..a.len());
+    crossover_at(a, b, cut, first, second);
+}
+
+/// With probability `rate`, adds Cauchy noise to one uniformly chosen gene.
+/// Returns the gene mutated, if any.
+pub fn mutate_one_gene(rng: &mut Stream, genes: &mut [f64], rate: f64, alpha: f64, limit: f64) -> Option<usize> {
+    if rng.random::<f64>() < rate {
+        let k = rng.random_range(0..genes.len());
+        genes[k] += cauchy(rng, alpha, limit);
+        Some(k)
+    } else {
+        None
+    }
+}
+
+/// Weights uniform in (-range, range).
+pub fn random_genes(rng: &mut Stream, count: usize, range: f64) -> Vec<f64> {
+    (0..count).map(|_| rng.random_range(-range..range)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::stream;
+
+    #[test]
+    fn crossover_cuts_at_the_given_gene() {
+        let a = [1.0, 2.0, 3.0, 4.0];
+        let b = [10.0, 20.0, 30.0, 40.0];
+        let (mut c, mut d) = ([0.0; 4], [0.0; 4]);
+        crossover_at(&a, &b, 1, &mut c, &mut d);
+        assert_eq!((c, d), ([1.0, 20.0, 30.0, 40.0], [10.0, 2.0, 3.0, 4.0]));
+        crossover_at(&a, &b, 0, &mut c, &mut d);
+        assert_eq!((c, d), (b, a));
+        crossover_at(&a, &b, 3, &mut c, &mut d);
+        assert_eq!((c, d), ([1.0, 2.0, 3.0, 40.0], [10.0, 20.0, 30.0, 4.0]));
+    }
+
+    #[test]
+    fn crossover_cut_is_uniform_over_the_genes() {
+        let mut rng = stream(1, &[]);
+        let a = [1.0; 11];
+        let b = [0.0; 11];
+        let mut counts = [0usize; 11];
+        let (mut c, mut d) = ([0.0; 11], [0.0; 11]);
+        for _ in 0..22_000 {
+            crossover(&mut rng, &a, &b, &mut c, &mut d);
+            counts[c.iter().sum::<f64>() as usize] += 1;
+        }
+        // Each cut 0..=10 about 2000 times (sd about 43).
+        assert!(counts.iter().all(|&n| (1800..2200).contains(&n)), "{counts:?}");
+    }
+
+    #[test]
+    fn cauchy_draws_are_clipped_and_have_the_right_scale() {
+        let mut rng = stream(2, &[]);
+        let draws: Vec<f64> = (0..100_000).map(|_| cauchy(&mut rng, 0.3, 10.0)).collect();
+        assert!(draws.iter().all(|x| x.abs() <= 10.0));
+        // The median of |X| for a Cauchy of scale alpha is alpha.
+        let mut abs: Vec<f64> = draws.iter().map(|x| x.abs()).collect();
+        abs.sort_by(f64::total_cmp);
+        let median = abs[abs.len() / 2];
+        assert!((median - 0.3).abs() < 0.01, "median {median}");
+        // Heavy tails survive up to the limit: some draws beyond 5.
+        assert!(abs.iter().filter(|x| **x > 5.0).count() > 100);
+        // A tight limit clips everything to it.
+        assert!((0..1000).all(|_| cauchy(&mut rng, 1.0, 0.5).abs() <= 0.5));
+    }
+
+    #[test]
+    fn mutation_touches_one_gene_with_the_configured_probability() {
+        let mut rng = stream(3, &[]);
+        let mut mutated = 0;
+        for _ in 0..20_000 {
+            let mut genes = [0.0; 11];
+            match mutate_one_gene(&mut rng, &mut genes, 0.4, 0.3, 10.0) {
+                Some(k) => {
+                    mutated += 1;
+                    assert!(genes.iter().enumerate().all(|(i, g)| (i == k) == (*g != 0.0)));
+                }
+                None => assert_eq!(genes, [0.0; 11]),
+            }
+        }
+        // 8000 expected, sd about 69.
+        assert!((7700..8300).contains(&mutated), "{mutated}");
+    }
+}

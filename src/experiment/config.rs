@@ -1,0 +1,189 @@
+//! A run's whole configuration, the paper's presets, and TOML overrides.
+
+use std::fmt;
+use std::path::Path;
+use std::str::FromStr;
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::evolution::{BurstMode, Credit, EspSettings, HillClimbSettings, Sampling, TopologyMode};
+use crate::psa::PsaSettings;
+
+/// Which search algorithm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Algorithm {
+    /// Enforced Sub-Populations.
+    Esp,
+    /// The hill-climber.
+    HillClimb,
+}
+
+/// Everything that defines a run but its task and seed; written beside
+/// every result as `config.toml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    /// The search algorithm.
+    pub algorithm: Algorithm,
+    /// ESP's settings (used when `algorithm = "esp"`).
+    pub esp: EspSettings,
+    /// The hill-climber's settings (used when `algorithm = "hill_climb"`).
+    pub hill_climb: HillClimbSettings,
+    /// The control problem.
+    pub problem: PsaSettings,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        Preset::Baseline.config()
+    }
+}
+
+/// One configuration of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Preset {
+    /// ESP with burst mutation discarding all sub-populations (Table 1).
+    Baseline,
+    /// Systematic sampling (Table 4).
+    Systematic,
+    /// Max credit (Table 5).
+    MaxCredit,
+    /// No lesion tests (Table 6).
+    LesionOff,
+    /// Erase the best network on topology changes (Table 6).
+    EraseBest,
+    /// The hill-climber (Table 7).
+    HillClimb,
+    /// ESP as Gomez defined it, without the discard-all change.
+    Gomez,
+}
+
+impl Preset {
+    /// Every preset, in the paper's order.
+    pub const ALL: [Preset; 7] = [
+        Preset::Baseline,
+        Preset::Systematic,
+        Preset::MaxCredit,
+        Preset::LesionOff,
+        Preset::EraseBest,
+        Preset::HillClimb,
+        Preset::Gomez,
+    ];
+
+    /// The preset's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Baseline => "baseline",
+            Preset::Systematic => "systematic",
+            Preset::MaxCredit => "max-credit",
+            Preset::LesionOff => "lesion-off",
+            Preset::EraseBest => "erase-best",
+            Preset::HillClimb => "hill-climb",
+            Preset::Gomez => "gomez",
+        }
+    }
+
+    /// The configuration: the baseline with this preset's one change.
+    pub fn config(self) -> RunConfig {
+        let esp = EspSettings::default();
+        let mut config = RunConfig {
+            algorithm: Algorithm::Esp,
+            esp: esp.clone(),
+            hill_climb: HillClimbSettings::default(),
+            problem: PsaSettings::default(),
+        };
+        match self {
+            Preset::Baseline => {}
+            Preset::Systematic => config.esp.sampling = Sampling::Systematic,
+            Preset::MaxCredit => config.esp.credit = Credit::Max,
+            Preset::LesionOff => config.esp.topology = TopologyMode::Off,
+            Preset::EraseBest => config.esp.erase_best = true,
+            Preset::HillClimb => config.algorithm = Algorithm::HillClimb,
+            Preset::Gomez => config.esp.burst = BurstMode::Gomez,
+        }
+        config
+    }
+}
+
+impl fmt::Display for Preset {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Preset {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Preset, String> {
+        Preset::ALL.into_iter().find(|p| p.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+            format!("unknown preset {s:?} (expected one of {})", names.join(", "))
+        })
+    }
+}
+
+/// Overlays `overrides` onto `base`, table by table.
+fn merge(base: &mut toml::Table, overrides: toml::Table) {
+    for (key, value) in overrides {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, value) => {
+                base.insert(key, value);
+            }
+        }
+    }
+}
+
+impl RunConfig {
+    /// Rejects out-of-range values, naming the setting.
+    pub fn validate(&self) -> Result<()> {
+        self.esp.validate().map_err(anyhow::Error::msg)?;
+        self.hill_climb.validate().map_err(anyhow::Error::msg)?;
+        self.problem.validate().context("problem")?;
+        Ok(())
+    }
+
+    /// This configuration with the settings of a TOML document laid over it;
+    /// unknown keys and out-of-range values are errors naming the key.
+    pub fn with_overrides(&self, toml_text: &str) -> Result<RunConfig> {
+        let overrides: toml::Table = toml::from_str(toml_text)?;
+        let mut table = toml::Table::try_from(self)?;
+        merge(&mut table, overrides);
+        let config: RunConfig = table.try_into()?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// [`RunConfig::with_overrides`] with the contents of a file.
+    pub fn with_overrides_from(&self, path: &Path) -> Result<RunConfig> {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("cannot read configuration {}", path.display()))?;
+        self.with_overrides(&text)
+            .with_context(|| format!("configuration {}", path.display()))
+    }
+
+    /// The configuration as TOML.
+    pub fn to_toml(&self) -> Result<String> {
+        Ok(toml::to_string(self)?)
+    }
+
+    /// Overrides the generations (ESP) or cycles (hill-climber).
+    pub fn set_generations(&mut self, generations: usize) -> Result<()> {
+        if generations == 0 {
+            bail!("--generations must be >= 1, got 0");
+        }
+        self.esp.generations = generations;
+        self.hill_climb.cycles = generations;
+        Ok(())
+    }
+
+    /// Generations (or cycles) of the configured algorithm.
+    pub fn generations(&self) -> usize {
+        match self.algorithm {
+            Algorithm::Esp => self.esp.generations,
+            Algorithm::HillClimb => self.hill_climb.cycles,
+        }
+    }
+}

@@ -1,0 +1,10 @@
+//! Experiments: the PSA as an evaluation function, run configurations and
+//! presets, and single evolution runs written to disk.
+
+mod config;
+mod evaluator;
+mod run;
+
+pub use config::{Algorithm, Preset, RunConfig};
+pub use evaluator::PsaEvaluator;
+pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles};
