@@ -2,6 +2,7 @@
 
 mod bench;
 mod crosscheck;
+mod evolve;
 mod replay;
 mod simulate;
 
@@ -30,6 +31,8 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Run random thrust sequences on every backend and compare each with ODE.
     Crosscheck(crosscheck::CrosscheckArgs),
+    /// Evolve a controller: one run of a preset on a task.
+    Evolve(evolve::EvolveArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
     Replay(replay::ReplayArgs),
     /// Measure ns per physics step of every backend in one run.
@@ -41,6 +44,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
     match cli.command {
         Command::Simulate(args) => simulate::run(args),
         Command::Crosscheck(args) => crosscheck::run(args),
+        Command::Evolve(args) => evolve::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
     }

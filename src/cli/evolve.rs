@@ -1,0 +1,102 @@
+//! `psa-esp evolve`: one evolution run of a preset on a task.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::experiment::{run_evolution, Preset};
+use crate::physics::BackendKind;
+use crate::psa::Task;
+
+/// Arguments of `evolve`.
+#[derive(Debug, clap::Args)]
+pub struct EvolveArgs {
+    /// Task 1, 2 or 3.
+    #[arg(long)]
+    pub task: Task,
+    /// The paper's configuration to start from.
+    #[arg(long, value_enum, default_value_t = Preset::Baseline)]
+    pub preset: Preset,
+    /// Seed of the run.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Generations (ESP) or cycles (hill-climber), overriding the configuration.
+    #[arg(long)]
+    pub generations: Option<usize>,
+    /// A TOML file overriding any setting of the preset (see README).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Physics backend, overriding the configuration.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendKind>,
+    /// Worker threads (0 = one per core). Results do not depend on it.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Output directory (default: evolve-<preset>-task<T>-seed<S>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print the run summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A progress bar on standard error (drawn only on a terminal).
+pub fn progress_bar(len: u64, template: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// Runs `evolve`.
+pub fn run(args: EvolveArgs) -> Result<i32> {
+    let mut config = args.preset.config();
+    if let Some(path) = &args.config {
+        config = config.with_overrides_from(path)?;
+    }
+    if let Some(g) = args.generations {
+        config.set_generations(g)?;
+    }
+    if let Some(backend) = args.backend {
+        config.problem.backend = backend;
+    }
+    config.validate()?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("evolve-{}-task{}-seed{}", args.preset, args.task, args.seed)));
+    let bar = progress_bar(
+        config.generations() as u64,
+        "{spinner} generation {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
+    );
+    let pool = crate::ode::thread_pool(args.threads)?;
+    let outcome = pool.install(|| {
+        run_evolution(&config, args.preset.name(), args.task, args.seed, &out, |record| {
+            bar.set_position(record.generation as u64);
+            bar.set_message(format!("champion {:.1} %", record.champion));
+        })
+    })?;
+    bar.finish_and_clear();
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&outcome)?);
+    } else {
+        println!(
+            "{} on task {} (seed {}): champion {:.2} % after {} generations, {} evaluations, {} burst mutations, {} hidden neurons; {:.1} s",
+            args.preset,
+            args.task,
+            args.seed,
+            outcome.champion_fitness,
+            outcome.generations,
+            outcome.evaluations,
+            outcome.bursts,
+            outcome.champion_hidden,
+            outcome.seconds
+        );
+        println!("wrote {}", out.display());
+    }
+    Ok(0)
+}
