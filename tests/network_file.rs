@@ -74,7 +74,8 @@ fn malformed_files_are_rejected_with_the_file_and_the_problem() {
             "not valid JSON",
         ),
     ];
-    let mutations: Vec<(&str, fn(&mut serde_json::Value), &str)> = vec![
+    type Mutation = (&'static str, fn(&mut serde_json::Value), &'static str);
+    let mutations: Vec<Mutation> = vec![
         ("version", |v| v["version"] = 99.into(), "unknown version 99"),
         (
             "format",

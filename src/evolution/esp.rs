@@ -540,8 +540,8 @@ mod tests {
         // Neuron k's genes all equal k: a child's genes show its parents.
         let mut subpop: Vec<Vec<f64>> = (0..12).map(|k| vec![k as f64; 5]).collect();
         e.recombine(&mut subpop, 1, 0);
-        for k in 0..6 {
-            assert_eq!(subpop[k], vec![k as f64; 5], "the top half survives unchanged");
+        for (k, neuron) in subpop.iter().enumerate().take(6) {
+            assert_eq!(*neuron, vec![k as f64; 5], "the top half survives unchanged");
         }
         for j in 0..3 {
             let (first, second) = (&subpop[11 - 2 * j], &subpop[10 - 2 * j]);
