@@ -1,4 +1,4 @@
-//! ns per physics step of each backend on the PSA body (criterion).
+//! ns per physics step and per PSA network evaluation of each backend (criterion).
 //! `psa-esp bench` measures the same in one run and prints a table.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -27,5 +27,31 @@ fn physics_step(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, physics_step);
+/// One PSA network evaluation (a 500-step trial of task 1) per backend.
+fn psa_evaluation(c: &mut Criterion) {
+    use psa_esp::evolution::operators::random_genes;
+    use psa_esp::network::Network;
+    use psa_esp::psa::{PsaSettings, Task, TrialRunner};
+    let mut rng = psa_esp::rng::stream(1, &[]);
+    let network = Network::from_genes(7, 4, random_genes(&mut rng, 55, 6.0)).expect("valid network");
+    let mut group = c.benchmark_group("psa_evaluation");
+    group.sample_size(20);
+    for kind in BackendKind::available() {
+        let settings = PsaSettings {
+            backend: kind,
+            ..PsaSettings::default()
+        };
+        let mut runner = TrialRunner::new(&settings, Task::StopRotation).expect("runner");
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                runner
+                    .evaluate(&network, &mut psa_esp::rng::stream(0, &[]))
+                    .expect("evaluate")
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, physics_step, psa_evaluation);
 criterion_main!(benches);

@@ -1,13 +1,18 @@
-//! `psa-esp bench`: ns per physics step of every backend, measured in one
-//! run with the backends interleaved so that machine noise hits them alike.
+//! `psa-esp bench`: ns per physics step of every backend (interleaved so
+//! that machine noise hits them alike) and PSA network evaluations per
+//! second per backend on 1 and 2 threads, all measured in one run.
 
 use std::time::Instant;
 
 use anyhow::Result;
 use serde::Serialize;
 
+use crate::evolution::evaluate_all;
+use crate::evolution::operators::random_genes;
+use crate::experiment::PsaEvaluator;
+use crate::network::Network;
 use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, PhysicsBackend};
-use crate::psa::BodySettings;
+use crate::psa::{BodySettings, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
 
 /// Arguments of `bench`.
 #[derive(Debug, clap::Args)]
@@ -18,9 +23,55 @@ pub struct BenchArgs {
     /// Interleaved rounds; the median round is reported.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..))]
     pub rounds: u64,
+    /// Networks per round of the evaluation benchmark.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
+    pub networks: u64,
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// One backend's speed at whole network evaluations (one 500-step trial each).
+#[derive(Debug, Serialize)]
+struct EvaluationTiming {
+    backend: BackendKind,
+    evaluations_per_second_1_thread: f64,
+    evaluations_per_second_2_threads: f64,
+    speedup_2_threads: f64,
+    ns_per_network_step_1_thread: f64,
+}
+
+/// Random 7-5-4 networks, weights uniform in (-6, 6) as ESP starts them.
+fn random_networks(count: u64) -> Result<Vec<Network>> {
+    let mut rng = crate::rng::stream(1, &[]);
+    (0..count)
+        .map(|_| {
+            Ok(Network::from_genes(
+                INPUT_COUNT,
+                THRUSTER_COUNT,
+                random_genes(&mut rng, 5 * 11, 6.0),
+            )?)
+        })
+        .collect()
+}
+
+/// Evaluations per second of `networks` on task 1 with `threads` threads
+/// (median of `rounds` rounds).
+fn evaluations_per_second(kind: BackendKind, networks: &[Network], threads: usize, rounds: u64) -> Result<f64> {
+    let settings = PsaSettings {
+        backend: kind,
+        ..PsaSettings::default()
+    };
+    let evaluator = PsaEvaluator::new(settings, Task::StopRotation)?;
+    let pool = crate::ode::thread_pool(threads)?;
+    let mut rates = Vec::new();
+    for round in 0..rounds {
+        let start = Instant::now();
+        pool.install(|| evaluate_all(&evaluator, networks, round, &[]))?;
+        rates.push(networks.len() as f64 / start.elapsed().as_secs_f64());
+    }
+    rates.sort_by(f64::total_cmp);
+    Ok(rates[rates.len() / 2])
 }
 
 /// One backend's timing.
@@ -100,9 +151,32 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             relative_to_ode: m / ode,
         })
         .collect();
+    let networks = random_networks(args.networks)?;
+    let steps_per_evaluation = PsaSettings::default().steps as f64;
+    let evaluations = kinds
+        .iter()
+        .map(|&backend| {
+            let one = evaluations_per_second(backend, &networks, 1, args.rounds)?;
+            let two = evaluations_per_second(backend, &networks, 2, args.rounds)?;
+            Ok(EvaluationTiming {
+                backend,
+                evaluations_per_second_1_thread: one,
+                evaluations_per_second_2_threads: two,
+                speedup_2_threads: two / one,
+                ns_per_network_step_1_thread: 1e9 / (one * steps_per_evaluation),
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
     let machine = machine();
     if args.json {
-        let out = serde_json::json!({ "machine": machine, "steps_per_round": args.steps, "rounds": args.rounds, "physics_step": timings });
+        let out = serde_json::json!({
+            "machine": machine,
+            "steps_per_round": args.steps,
+            "rounds": args.rounds,
+            "physics_step": timings,
+            "networks_per_round": args.networks,
+            "psa_evaluation": evaluations,
+        });
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         println!("machine: {} ({} cores)", machine.cpu, machine.cores);
@@ -118,6 +192,24 @@ pub fn run(args: BenchArgs) -> Result<i32> {
                 t.median_ns_per_step,
                 t.min_ns_per_step,
                 t.relative_to_ode
+            );
+        }
+        println!(
+            "PSA network evaluations (7-5-4 random networks, task 1, {} steps each, {} networks per round, median):",
+            steps_per_evaluation, args.networks
+        );
+        println!(
+            "{:<8} {:>14} {:>14} {:>9} {:>16}",
+            "backend", "evals/s 1 thr", "evals/s 2 thr", "speed-up", "ns/network-step"
+        );
+        for e in &evaluations {
+            println!(
+                "{:<8} {:>14.0} {:>14.0} {:>8.2}x {:>16.1}",
+                e.backend.name(),
+                e.evaluations_per_second_1_thread,
+                e.evaluations_per_second_2_threads,
+                e.speedup_2_threads,
+                e.ns_per_network_step_1_thread
             );
         }
     }

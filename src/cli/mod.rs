@@ -35,7 +35,7 @@ pub enum Command {
     Evolve(evolve::EvolveArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
     Replay(replay::ReplayArgs),
-    /// Measure ns per physics step of every backend in one run.
+    /// Measure physics steps and network evaluations of every backend in one run.
     Bench(bench::BenchArgs),
 }
 
