@@ -187,3 +187,99 @@ impl RunConfig {
         }
     }
 }
+
+/// One configuration of the replication grid: a preset of the paper's
+/// Tables 1 and 4-7 (and Gomez's ESP), or one of Table 3's two, evolved
+/// under input noise or random initialisation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum GridConfig {
+    /// A preset.
+    Preset(Preset),
+    /// Baseline ESP evolved under input noise sd 0.05, each network evaluated 3 times (Table 3).
+    InputNoise,
+    /// Baseline ESP evolved with random initial conditions, each network evaluated 3 times (Table 3; tasks 1 and 3).
+    RandomInit,
+}
+
+/// Input noise of Table 3's evolution and of the robustness tests. [paper] 0.05
+pub const PAPER_NOISE_SD: f64 = 0.05;
+/// Trials per evaluation under noise or random initialisation. [paper] 3
+pub const PAPER_NOISY_TRIALS: usize = 3;
+
+impl GridConfig {
+    /// Every configuration of the grid, in report order.
+    pub const ALL: [GridConfig; 9] = [
+        GridConfig::Preset(Preset::Baseline),
+        GridConfig::Preset(Preset::Systematic),
+        GridConfig::Preset(Preset::MaxCredit),
+        GridConfig::Preset(Preset::LesionOff),
+        GridConfig::Preset(Preset::EraseBest),
+        GridConfig::Preset(Preset::HillClimb),
+        GridConfig::Preset(Preset::Gomez),
+        GridConfig::InputNoise,
+        GridConfig::RandomInit,
+    ];
+
+    /// The configuration's name (folder and command-line name).
+    pub fn name(self) -> &'static str {
+        match self {
+            GridConfig::Preset(p) => p.name(),
+            GridConfig::InputNoise => "input-noise",
+            GridConfig::RandomInit => "random-init",
+        }
+    }
+
+    /// The run configuration.
+    pub fn config(self) -> RunConfig {
+        match self {
+            GridConfig::Preset(p) => p.config(),
+            GridConfig::InputNoise => {
+                let mut c = Preset::Baseline.config();
+                c.problem.noise.input_sd = PAPER_NOISE_SD;
+                c.problem.trials = PAPER_NOISY_TRIALS;
+                c
+            }
+            GridConfig::RandomInit => {
+                let mut c = Preset::Baseline.config();
+                c.problem.random_init = true;
+                c.problem.trials = PAPER_NOISY_TRIALS;
+                c
+            }
+        }
+    }
+
+    /// Whether the configuration applies to `task` (random initialisation: tasks 1 and 3 only).
+    pub fn applies_to(self, task: crate::psa::Task) -> bool {
+        self != GridConfig::RandomInit || task.has_random_init()
+    }
+}
+
+impl fmt::Display for GridConfig {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for GridConfig {
+    type Err = String;
+    fn from_str(s: &str) -> Result<GridConfig, String> {
+        GridConfig::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = GridConfig::ALL.iter().map(|c| c.name()).collect();
+            format!("unknown configuration {s:?} (expected one of {})", names.join(", "))
+        })
+    }
+}
+
+impl TryFrom<String> for GridConfig {
+    type Error = String;
+    fn try_from(s: String) -> Result<GridConfig, String> {
+        s.parse()
+    }
+}
+
+impl From<GridConfig> for String {
+    fn from(c: GridConfig) -> String {
+        c.name().to_string()
+    }
+}

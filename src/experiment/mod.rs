@@ -5,6 +5,6 @@ mod config;
 mod evaluator;
 mod run;
 
-pub use config::{Algorithm, Preset, RunConfig};
+pub use config::{Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};
 pub use evaluator::PsaEvaluator;
 pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles};

@@ -46,6 +46,8 @@ pub struct EvolveOutcome {
     pub seed: u64,
     /// A label for the configuration (the preset's name).
     pub label: String,
+    /// The physics backend.
+    pub backend: crate::physics::BackendKind,
     /// The champion's fitness (% of the theoretical maximum).
     pub champion_fitness: f64,
     /// The generation (cycle) it was found in.
@@ -128,6 +130,7 @@ pub fn run_evolution(
         task,
         seed,
         label: label.to_string(),
+        backend: config.problem.backend,
         champion_fitness: champion.fitness,
         champion_generation: champion.generation,
         generations: result.records.len(),
