@@ -3,6 +3,8 @@
 
 mod config;
 mod evaluator;
+pub mod grid;
+pub mod robustness;
 mod run;
 
 pub use config::{Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};

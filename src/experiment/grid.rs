@@ -1,0 +1,243 @@
+//! The replication grid on disk: its definition (`grid.json`), one folder
+//! per (configuration, task, seed) run, and how a folder is judged
+//! finished, missing or damaged.
+//!
+//! ```text
+//! DIR/grid.json
+//! DIR/runs/<config>/task<T>/seed<S>/config.toml     resolved configuration (written first)
+//!                                   records.csv     one row per generation
+//!                                   champion.json   the champion network
+//!                                   run.json        results and provenance
+//!                                   robustness.json the robustness tests (written last: the run is finished)
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+
+use super::{GridConfig, RunConfig};
+use crate::physics::BackendKind;
+use crate::psa::Task;
+
+/// The `format` of `grid.json`.
+pub const GRID_FORMAT: &str = "psa-esp-grid";
+/// Its version.
+pub const GRID_VERSION: u32 = 1;
+
+/// Which protocol a grid follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum GridPreset {
+    /// A reduced grid that finishes in about 5 minutes on 2 cores.
+    Quick,
+    /// The paper's full protocol: 2000 generations, 30 seeds, 500-trial robustness tests.
+    Paper,
+}
+
+/// A grid's definition, written to `grid.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridSpec {
+    /// Always [`GRID_FORMAT`].
+    pub format: String,
+    /// Always [`GRID_VERSION`].
+    pub version: u32,
+    /// The preset the grid started from.
+    pub preset: GridPreset,
+    /// The configurations.
+    pub configs: Vec<GridConfig>,
+    /// The tasks.
+    pub tasks: Vec<Task>,
+    /// Seeds 1..=seeds.
+    pub seeds: u64,
+    /// Generations (ESP) or cycles (hill-climber) per run.
+    pub generations: usize,
+    /// Physics backend.
+    pub backend: BackendKind,
+    /// Trials of each robustness test.
+    pub robustness_trials: usize,
+}
+
+/// The folder status of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunStatus {
+    /// Not started (no folder).
+    Missing,
+    /// Started but not finished (killed): it will be run again.
+    Unfinished,
+    /// Finished: every file present.
+    Finished,
+}
+
+/// One (configuration, task, seed) cell of the grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct RunKey {
+    /// The configuration.
+    pub config: GridConfig,
+    /// The task.
+    pub task: Task,
+    /// The seed.
+    pub seed: u64,
+}
+
+impl GridSpec {
+    /// The definition of `preset` (all configurations and tasks).
+    pub fn from_preset(preset: GridPreset) -> GridSpec {
+        let (seeds, generations, backend, robustness_trials) = match preset {
+            GridPreset::Quick => (5, 80, BackendKind::Native, 100),
+            GridPreset::Paper => (30, 2000, BackendKind::Ode, 500),
+        };
+        GridSpec {
+            format: GRID_FORMAT.into(),
+            version: GRID_VERSION,
+            preset,
+            configs: GridConfig::ALL.to_vec(),
+            tasks: Task::ALL.to_vec(),
+            seeds,
+            generations,
+            backend,
+            robustness_trials,
+        }
+    }
+
+    /// Whether this grid is smaller than the paper's protocol.
+    pub fn is_reduced(&self) -> bool {
+        let paper = GridSpec::from_preset(GridPreset::Paper);
+        self.seeds < paper.seeds
+            || self.generations < paper.generations
+            || self.robustness_trials < paper.robustness_trials
+            || paper.configs.iter().any(|c| !self.configs.contains(c))
+            || paper.tasks.iter().any(|t| !self.tasks.contains(t))
+    }
+
+    /// Rejects an empty or impossible grid.
+    pub fn validate(&self) -> Result<()> {
+        if self.configs.is_empty() || self.tasks.is_empty() {
+            bail!("the grid needs at least one configuration and one task");
+        }
+        if self.seeds == 0 || self.generations == 0 || self.robustness_trials == 0 {
+            bail!(
+                "seeds, generations and robustness trials must be >= 1, got {}, {} and {}",
+                self.seeds,
+                self.generations,
+                self.robustness_trials
+            );
+        }
+        if !self.backend.is_available() {
+            bail!("backend {} is not available in this build", self.backend);
+        }
+        Ok(())
+    }
+
+    /// Every run of the grid, in a fixed order (configuration, task, seed).
+    pub fn runs(&self) -> Vec<RunKey> {
+        let mut runs = Vec::new();
+        for &config in &self.configs {
+            for &task in &self.tasks {
+                if !config.applies_to(task) {
+                    continue;
+                }
+                for seed in 1..=self.seeds {
+                    runs.push(RunKey { config, task, seed });
+                }
+            }
+        }
+        runs
+    }
+
+    /// The full configuration a run of `config` uses in this grid.
+    pub fn run_config(&self, config: GridConfig) -> RunConfig {
+        let mut c = config.config();
+        c.esp.generations = self.generations;
+        c.hill_climb.cycles = self.generations;
+        c.problem.backend = self.backend;
+        c
+    }
+
+    /// Reads `DIR/grid.json`, checking its format and version.
+    pub fn load(dir: &Path) -> Result<GridSpec> {
+        let path = grid_file(dir);
+        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
+        if value.get("format").and_then(|f| f.as_str()) != Some(GRID_FORMAT) {
+            bail!(
+                "{}: not a psa-esp grid file (no \"format\": {GRID_FORMAT:?})",
+                path.display()
+            );
+        }
+        if value.get("version").and_then(|v| v.as_u64()) != Some(GRID_VERSION as u64) {
+            bail!(
+                "{}: unknown grid version; this build reads version {GRID_VERSION}",
+                path.display()
+            );
+        }
+        let spec: GridSpec = serde_json::from_value(value).with_context(|| format!("{}", path.display()))?;
+        spec.validate().with_context(|| format!("{}", path.display()))?;
+        Ok(spec)
+    }
+
+    /// Writes `DIR/grid.json` atomically.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        let mut json = serde_json::to_string_pretty(self)?;
+        json.push('\n');
+        crate::io::write_atomic(&grid_file(dir), json.as_bytes())
+    }
+}
+
+/// `DIR/grid.json`.
+pub fn grid_file(dir: &Path) -> PathBuf {
+    dir.join("grid.json")
+}
+
+/// The folder of one run.
+pub fn run_dir(dir: &Path, key: &RunKey) -> PathBuf {
+    dir.join("runs")
+        .join(key.config.name())
+        .join(format!("task{}", key.task))
+        .join(format!("seed{}", key.seed))
+}
+
+/// The file whose presence marks a run finished (written last).
+pub const FINISHED_MARKER: &str = "robustness.json";
+
+/// Judges a run folder: missing, unfinished (to be run again), finished,
+/// or an error naming the folder when it holds another configuration or a
+/// damaged file.
+pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus> {
+    let folder = run_dir(dir, key);
+    if !folder.exists() {
+        return Ok(RunStatus::Missing);
+    }
+    let config_path = folder.join("config.toml");
+    if !config_path.exists() {
+        // Killed before its first file: nothing of value in it.
+        return Ok(RunStatus::Unfinished);
+    }
+    let text =
+        std::fs::read_to_string(&config_path).with_context(|| format!("cannot read {}", config_path.display()))?;
+    let expected = spec.run_config(key.config);
+    let found = RunConfig::default()
+        .with_overrides(&text)
+        .with_context(|| format!("{}: damaged configuration", config_path.display()))?;
+    if found != expected {
+        bail!(
+            "{}: holds a different configuration than {} in this grid (another grid's run?); move it away or use another output directory",
+            folder.display(),
+            key.config
+        );
+    }
+    if !folder.join(FINISHED_MARKER).exists() {
+        return Ok(RunStatus::Unfinished);
+    }
+    for name in ["records.csv", "champion.json", "run.json"] {
+        if !folder.join(name).exists() {
+            bail!(
+                "{}: finished run without {name}: the folder is damaged",
+                folder.display()
+            );
+        }
+    }
+    Ok(RunStatus::Finished)
+}

@@ -1,0 +1,103 @@
+//! The robustness stage (Tables 2 and 3): a champion flown many times under
+//! input noise and, for tasks 1 and 3, from random initial conditions.
+
+use anyhow::Result;
+use serde::{Deserialize, Serialize};
+
+use super::PAPER_NOISE_SD;
+use crate::network::Network;
+use crate::psa::{NoiseSettings, PsaSettings, Task, TrialRunner};
+use crate::rng::stream;
+
+/// Stream keys of the robustness tests.
+const CLEAN: u64 = 0x636c_6561_6e;
+const INPUT_NOISE: u64 = 0x6e6f_6973_65;
+const RANDOM_INIT: u64 = 0x7261_6e64_6f6d;
+
+/// Mean and sample standard deviation of a champion's fitness over trials (%).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrialSummary {
+    /// Mean fitness (% of the theoretical maximum).
+    pub mean: f64,
+    /// Sample standard deviation over the trials.
+    pub sd: f64,
+}
+
+impl TrialSummary {
+    /// The summary of `values` (sd 0 for a single value).
+    pub fn of(values: &[f64]) -> TrialSummary {
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let sd = if values.len() > 1 {
+            (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+        } else {
+            0.0
+        };
+        TrialSummary { mean, sd }
+    }
+}
+
+/// What `robustness.json` holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Robustness {
+    /// Trials of each test.
+    pub trials: usize,
+    /// The input noise of the noise test (sd). [paper] 0.05
+    pub input_noise_sd: f64,
+    /// The champion flown once without noise from the task's standard start.
+    pub clean: f64,
+    /// Under Gaussian input noise.
+    pub input_noise: TrialSummary,
+    /// From random initial conditions (tasks 1 and 3; none for task 2).
+    pub random_init: Option<TrialSummary>,
+}
+
+/// Runs the robustness tests of `champion` on `task`. `problem` is the
+/// run's control problem; its noise, random initialisation and trials are
+/// replaced by each test's own.
+pub fn test_robustness(
+    champion: &Network,
+    task: Task,
+    problem: &PsaSettings,
+    trials: usize,
+    seed: u64,
+) -> Result<Robustness> {
+    let base = PsaSettings {
+        noise: NoiseSettings::default(),
+        random_init: false,
+        trials: 1,
+        ..problem.clone()
+    };
+    let clean = TrialRunner::new(&base, task)?.evaluate(champion, &mut stream(seed, &[CLEAN]))?;
+    let noisy = PsaSettings {
+        noise: NoiseSettings {
+            input_sd: PAPER_NOISE_SD,
+            output_sd: 0.0,
+        },
+        trials,
+        ..base.clone()
+    };
+    let input_noise = TrialSummary::of(
+        &TrialRunner::new(&noisy, task)?.evaluate_trials(champion, &mut stream(seed, &[INPUT_NOISE]))?,
+    );
+    let random_init = if task.has_random_init() {
+        let random = PsaSettings {
+            random_init: true,
+            trials,
+            ..base
+        };
+        Some(TrialSummary::of(
+            &TrialRunner::new(&random, task)?.evaluate_trials(champion, &mut stream(seed, &[RANDOM_INIT]))?,
+        ))
+    } else {
+        None
+    };
+    Ok(Robustness {
+        trials,
+        input_noise_sd: PAPER_NOISE_SD,
+        clean,
+        input_noise,
+        random_init,
+    })
+}
