@@ -4,6 +4,7 @@ mod bench;
 mod crosscheck;
 mod evolve;
 mod replay;
+mod replicate;
 mod simulate;
 
 use std::fmt::Write as _;
@@ -33,6 +34,8 @@ pub enum Command {
     Crosscheck(crosscheck::CrosscheckArgs),
     /// Evolve a controller: one run of a preset on a task.
     Evolve(evolve::EvolveArgs),
+    /// Run the paper's experiment grid (resumable).
+    Replicate(replicate::ReplicateArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
     Replay(replay::ReplayArgs),
     /// Measure physics steps and network evaluations of every backend in one run.
@@ -45,6 +48,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
         Command::Simulate(args) => simulate::run(args),
         Command::Crosscheck(args) => crosscheck::run(args),
         Command::Evolve(args) => evolve::run(args),
+        Command::Replicate(args) => replicate::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
     }

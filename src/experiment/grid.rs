@@ -239,5 +239,34 @@ pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus
             );
         }
     }
+    check_finished_files(&folder, spec)?;
     Ok(RunStatus::Finished)
+}
+
+/// Parses the files of a finished run, so that a damaged one is never
+/// counted: the robustness results, the summary, the champion, and a record
+/// per generation.
+fn check_finished_files(folder: &Path, spec: &GridSpec) -> Result<()> {
+    let read = |name: &str| -> Result<String> {
+        let path = folder.join(name);
+        std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))
+    };
+    let damaged = |name: &str| format!("{}: damaged file", folder.join(name).display());
+    serde_json::from_str::<super::robustness::Robustness>(&read(FINISHED_MARKER)?)
+        .with_context(|| damaged(FINISHED_MARKER))?;
+    let summary: serde_json::Value = serde_json::from_str(&read("run.json")?).with_context(|| damaged("run.json"))?;
+    if !summary.get("champion_fitness").is_some_and(|f| f.is_number()) {
+        bail!("{}: no champion_fitness", damaged("run.json"));
+    }
+    crate::psa::NetworkFile::load(&folder.join("champion.json"))?;
+    let rows = read("records.csv")?.lines().count();
+    if rows != spec.generations + 1 {
+        bail!(
+            "{}: {} rows, expected a header and {} generations",
+            damaged("records.csv"),
+            rows,
+            spec.generations
+        );
+    }
+    Ok(())
 }

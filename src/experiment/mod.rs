@@ -4,6 +4,7 @@
 mod config;
 mod evaluator;
 pub mod grid;
+pub mod replicate;
 pub mod robustness;
 mod run;
 

@@ -1,0 +1,116 @@
+//! `psa-esp replicate`: the paper's experiment grid.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use anyhow::Result;
+
+use super::evolve::progress_bar;
+use crate::experiment::grid::{GridPreset, GridSpec};
+use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress};
+use crate::experiment::GridConfig;
+use crate::physics::BackendKind;
+use crate::psa::Task;
+
+/// Arguments of `replicate`.
+#[derive(Debug, clap::Args)]
+pub struct ReplicateArgs {
+    /// quick: a reduced grid (5 seeds, 80 generations, 100-trial robustness,
+    /// native backend; about 5 minutes on 2 cores); paper: the full protocol
+    /// (30 seeds, 2000 generations, 500-trial robustness, ode backend).
+    #[arg(long, value_enum, default_value_t = GridPreset::Quick)]
+    pub preset: GridPreset,
+    /// Configurations, comma-separated (default: all of baseline, systematic,
+    /// max-credit, lesion-off, erase-best, hill-climb, gomez, input-noise, random-init).
+    #[arg(long, value_delimiter = ',')]
+    pub configs: Option<Vec<GridConfig>>,
+    /// Tasks, comma-separated (default: 1,2,3).
+    #[arg(long, value_delimiter = ',')]
+    pub tasks: Option<Vec<Task>>,
+    /// Seeds per configuration and task (seeds 1..=N).
+    #[arg(long)]
+    pub seeds: Option<u64>,
+    /// Generations (ESP) or cycles (hill-climber) per run.
+    #[arg(long)]
+    pub generations: Option<usize>,
+    /// Physics backend.
+    #[arg(long, value_enum)]
+    pub backend: Option<BackendKind>,
+    /// Trials of each robustness test.
+    #[arg(long)]
+    pub robustness_trials: Option<usize>,
+    /// Worker threads (0 = one per core). Results do not depend on it.
+    #[arg(long, default_value_t = 0)]
+    pub jobs: usize,
+    /// The grid's directory; running the same command again resumes it.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+impl ReplicateArgs {
+    /// The grid these options describe.
+    pub fn spec(&self) -> GridSpec {
+        let mut spec = GridSpec::from_preset(self.preset);
+        if let Some(c) = &self.configs {
+            spec.configs = c.clone();
+        }
+        if let Some(t) = &self.tasks {
+            spec.tasks = t.clone();
+        }
+        spec.seeds = self.seeds.unwrap_or(spec.seeds);
+        spec.generations = self.generations.unwrap_or(spec.generations);
+        spec.backend = self.backend.unwrap_or(spec.backend);
+        spec.robustness_trials = self.robustness_trials.unwrap_or(spec.robustness_trials);
+        spec
+    }
+}
+
+/// A bar over the whole grid and a line per finished run (both only on a terminal).
+struct Progress {
+    bar: indicatif::ProgressBar,
+    best: Mutex<f64>,
+}
+
+impl GridProgress for Progress {
+    fn start(&self, total: usize, done: usize) {
+        self.bar.set_length(total as u64);
+        self.bar.set_position(done as u64);
+        self.bar.reset_eta();
+    }
+
+    fn finished(&self, run: &FinishedRun) {
+        let mut best = self.best.lock().expect("no panics while holding the lock");
+        *best = best.max(run.outcome.champion_fitness);
+        self.bar.println(format!(
+            "finished {} task {} seed {}: champion {:.1} % ({:.0} s)",
+            run.key.config, run.key.task, run.key.seed, run.outcome.champion_fitness, run.outcome.seconds
+        ));
+        self.bar.set_message(format!("best champion {:.1} %", *best));
+        self.bar.inc(1);
+    }
+}
+
+/// Runs `replicate`.
+pub fn run(args: ReplicateArgs) -> Result<i32> {
+    let spec = args.spec();
+    let progress = Progress {
+        bar: progress_bar(
+            0,
+            "{spinner} runs {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
+        ),
+        best: Mutex::new(f64::NEG_INFINITY),
+    };
+    let summary = replicate(&args.out, &spec, args.jobs, &progress)?;
+    progress.bar.finish_and_clear();
+    println!(
+        "grid {} ({}): {} runs, {} already finished, {} run now in {:.0} s",
+        args.out.display(),
+        describe(&spec),
+        summary.total,
+        summary.skipped,
+        summary.ran,
+        summary.seconds
+    );
+    println!("next: psa-esp report {}", args.out.display());
+    Ok(0)
+}

@@ -1,0 +1,161 @@
+//! The replication grid end to end: resume after kill -9, damaged and
+//! foreign run folders, and the report of a tiny grid.
+
+use std::path::Path;
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn psa_esp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_psa-esp")).args(args).output().unwrap()
+}
+
+/// A small grid: 3 configurations x task 1 x 4 seeds, on one thread.
+fn grid_args(out: &Path) -> Vec<String> {
+    [
+        "replicate",
+        "--configs",
+        "baseline,max-credit,hill-climb",
+        "--tasks",
+        "1",
+        "--seeds",
+        "4",
+        "--generations",
+        "25",
+        "--robustness-trials",
+        "20",
+        "--jobs",
+        "1",
+        "--out",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .chain([out.to_str().unwrap().to_string()])
+    .collect()
+}
+
+/// Every result file of every run folder, by relative path (provenance
+/// times in run.json excluded: they say when, not what).
+fn results(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.join("runs")];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if ["records.csv", "champion.json", "robustness.json", "config.toml"]
+                .contains(&path.file_name().unwrap().to_str().unwrap())
+            {
+                files.push((
+                    path.strip_prefix(dir).unwrap().display().to_string(),
+                    std::fs::read(&path).unwrap(),
+                ));
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+fn finished_runs(dir: &Path) -> usize {
+    results(dir)
+        .iter()
+        .filter(|(p, _)| p.ends_with("robustness.json"))
+        .count()
+}
+
+#[test]
+fn a_grid_killed_part_way_resumes_to_the_same_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (whole, killed) = (tmp.path().join("whole"), tmp.path().join("killed"));
+    let o = psa_esp(&grid_args(&whole).iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(finished_runs(&whole), 12);
+
+    // Start the same grid elsewhere and kill -9 it once some runs are done.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_psa-esp"))
+        .args(grid_args(&killed))
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while killed
+        .join("runs")
+        .exists()
+        .then(|| finished_runs(&killed))
+        .unwrap_or(0)
+        < 2
+    {
+        assert!(Instant::now() < deadline, "no run finished in time");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done_before = finished_runs(&killed);
+    assert!(
+        done_before < 12,
+        "the grid finished before it could be killed; make it larger"
+    );
+
+    // Resuming skips the finished runs and completes the rest identically.
+    let o = psa_esp(&grid_args(&killed).iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains(&format!("{done_before} already finished")), "{stdout}");
+    assert!(
+        results(&whole) == results(&killed),
+        "resumed grid differs from the uninterrupted one"
+    );
+}
+
+#[test]
+fn damaged_or_foreign_run_folders_are_reported_and_left_untouched() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("grid");
+    let args = [
+        "replicate",
+        "--configs",
+        "baseline",
+        "--tasks",
+        "2",
+        "--seeds",
+        "3",
+        "--generations",
+        "3",
+        "--robustness-trials",
+        "5",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    assert!(psa_esp(&args).status.success());
+    let seed1 = dir.join("runs/baseline/task2/seed1");
+    let seed2 = dir.join("runs/baseline/task2/seed2");
+    let seed3 = dir.join("runs/baseline/task2/seed3");
+    // A truncated summary, a missing champion, another configuration under the same name.
+    let summary = std::fs::read_to_string(seed1.join("run.json")).unwrap();
+    std::fs::write(seed1.join("run.json"), &summary[..summary.len() / 2]).unwrap();
+    std::fs::remove_file(seed2.join("champion.json")).unwrap();
+    let config = std::fs::read_to_string(seed3.join("config.toml")).unwrap();
+    std::fs::write(
+        seed3.join("config.toml"),
+        config.replace("subpop_size = 40", "subpop_size = 20"),
+    )
+    .unwrap();
+    let before = results(&dir);
+    let o = psa_esp(&args);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    for (folder, needle) in [
+        (&seed1, "run.json"),
+        (&seed2, "champion.json"),
+        (&seed3, "different configuration"),
+    ] {
+        assert!(err.contains(folder.to_str().unwrap()), "{err}");
+        assert!(err.contains(needle), "{err}");
+    }
+    assert!(results(&dir) == before, "a damaged folder was overwritten");
+    // A directory of someone else's: run folders but no grid.json.
+    std::fs::remove_file(dir.join("grid.json")).unwrap();
+    let o = psa_esp(&args);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no grid.json"));
+}
