@@ -127,3 +127,67 @@ fn bench_prints_ns_per_step_for_every_backend() {
     assert_eq!(rows.len(), psa_esp::physics::BackendKind::available().len());
     assert!(rows.iter().all(|r| r["median_ns_per_step"].as_f64().unwrap() > 0.0));
 }
+
+/// A hand-made 7-3-4 spin damper: neuron 0 fires thrusters 2 and 3
+/// (clockwise torque) when omega > 0, neuron 1 fires 0 and 1 when omega < 0,
+/// neuron 2 is a constant that keeps every output near 0 otherwise.
+fn spin_damper() -> psa_esp::network::Network {
+    let omega = |w: f64, bias: f64, out: [f64; 4]| {
+        let mut genes = vec![0.0, 0.0, 0.0, 0.0, 0.0, w, bias];
+        genes.extend(out);
+        genes
+    };
+    psa_esp::network::Network::from_neurons(
+        7,
+        4,
+        &[
+            omega(20.0, -2.0, [0.0, 0.0, 8.0, 8.0]),
+            omega(-20.0, -2.0, [8.0, 8.0, 0.0, 0.0]),
+            omega(0.0, 10.0, [-8.0, -8.0, -8.0, -8.0]),
+        ],
+    )
+    .unwrap()
+}
+
+#[test]
+fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
+    use psa_esp::psa::{NetworkFile, SensorSettings, Task};
+    let dir = tempfile::tempdir().unwrap();
+    let net_path = dir.path().join("damper.json");
+    NetworkFile::new(&spin_damper(), Task::StopRotation, SensorSettings::default(), serde_json::Map::new())
+        .save(&net_path)
+        .unwrap();
+    let out = dir.path().join("replay");
+    let o = psa_esp(&["replay", net_path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    // It stops the spin within a few steps and stays in the box (1 point a
+    // step; doing nothing scores 0), and earns a little for the heading.
+    let fitness = summary["fitness_percent_mean"].as_f64().unwrap();
+    assert!(fitness > 25.0 && fitness < 100.0, "{fitness}");
+    let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    assert!(csv.starts_with("t,x,y,heading,vx,vy,omega,u0,u1,u2,u3,points"));
+    let last: Vec<f64> = csv.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
+    assert!(last[6].abs() < 0.05, "the spin is stopped: {last:?}");
+    let png = std::fs::read(out.join("trial.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 20_000, "{} bytes", png.len());
+    for svg in ["trial.svg", "trial-animation.svg"] {
+        let text = std::fs::read_to_string(out.join(svg)).unwrap();
+        assert!(text.contains("<svg") && text.trim_end().ends_with("</svg>") && text.len() > 20_000, "{svg}");
+    }
+    assert!(std::fs::read_to_string(out.join("trial-animation.svg")).unwrap().contains("<animate"));
+    // Several trials under noise: mean and sd over the trials.
+    let o = psa_esp(&["replay", net_path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--trials", "4",
+        "--input-noise", "0.05", "--random-init", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(summary["fitness_percent_per_trial"].as_array().unwrap().len(), 4);
+    // Bad input: task 2 has no random initialisation; a broken network file.
+    let o = psa_esp(&["replay", net_path.to_str().unwrap(), "--task", "2", "--random-init", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("task 2"));
+    std::fs::write(&net_path, "{").unwrap();
+    let o = psa_esp(&["replay", net_path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("damper.json") && stderr(&o).contains("not valid JSON"), "{}", stderr(&o));
+}

@@ -96,8 +96,12 @@ fn a_grid_killed_part_way_resumes_to_the_same_results() {
         "the grid finished before it could be killed; make it larger"
     );
 
-    // Resuming skips the finished runs and completes the rest identically.
-    let o = psa_esp(&grid_args(&killed).iter().map(String::as_str).collect::<Vec<_>>());
+    // Resuming (on two threads this time) skips the finished runs and
+    // completes the rest identically.
+    let mut resume = grid_args(&killed);
+    let jobs = resume.iter().position(|a| a == "--jobs").unwrap();
+    resume[jobs + 1] = "2".into();
+    let o = psa_esp(&resume.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(stdout.contains(&format!("{done_before} already finished")), "{stdout}");
