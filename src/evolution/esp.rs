@@ -169,6 +169,29 @@ struct State {
     evaluations: u64,
 }
 
+impl State {
+    /// The state before the first generation.
+    fn new(inputs: usize, outputs: usize, subpops: Vec<Vec<Vec<f64>>>) -> State {
+        State {
+            inputs,
+            outputs,
+            subpops,
+            best: None,
+            champion: None,
+            since_improvement: 0,
+            bursts_since_improvement: 0,
+            pending: None,
+            bursts: 0,
+            evaluations: 0,
+        }
+    }
+}
+
+/// A sub-population of `size` random neurons of `genes` genes.
+fn random_subpop(rng: &mut crate::rng::Stream, size: usize, genes: usize, range: f64) -> Vec<Vec<f64>> {
+    (0..size).map(|_| random_genes(rng, genes, range)).collect()
+}
+
 impl Esp {
     /// An ESP run with `settings` and `seed`; fails on invalid settings.
     pub fn new(settings: EspSettings, seed: u64) -> Result<Esp, String> {
@@ -192,24 +215,10 @@ impl Esp {
         let (inputs, outputs) = (evaluator.inputs(), evaluator.outputs());
         let genes = inputs + outputs;
         let mut rng = stream(self.seed, &[purpose::INIT]);
-        let mut state = State {
-            inputs,
-            outputs,
-            subpops: (0..s.initial_hidden)
-                .map(|_| {
-                    (0..s.subpop_size)
-                        .map(|_| random_genes(&mut rng, genes, s.init_range))
-                        .collect()
-                })
-                .collect(),
-            best: None,
-            champion: None,
-            since_improvement: 0,
-            bursts_since_improvement: 0,
-            pending: None,
-            bursts: 0,
-            evaluations: 0,
-        };
+        let subpops = (0..s.initial_hidden)
+            .map(|_| random_subpop(&mut rng, s.subpop_size, genes, s.init_range))
+            .collect();
+        let mut state = State::new(inputs, outputs, subpops);
         let mut records = Vec::with_capacity(s.generations);
         for generation in 1..=s.generations {
             let record = self.generation(evaluator, &mut state, generation)?;
@@ -475,11 +484,9 @@ impl Esp {
             LesionOutcome::Add => {
                 let mut rng = stream(self.seed, &[purpose::NEW_SUBPOP, generation as u64]);
                 let genes = state.inputs + state.outputs;
-                state.subpops.push(
-                    (0..s.subpop_size)
-                        .map(|_| random_genes(&mut rng, genes, s.init_range))
-                        .collect(),
-                );
+                state
+                    .subpops
+                    .push(random_subpop(&mut rng, s.subpop_size, genes, s.init_range));
             }
             LesionOutcome::Remove { neuron } => {
                 state.subpops.remove(neuron);
@@ -510,24 +517,10 @@ mod tests {
     /// A state of `hidden` sub-populations of 2-input, 1-output neurons.
     fn state(e: &Esp, hidden: usize) -> State {
         let mut rng = stream(5, &[]);
-        State {
-            inputs: 2,
-            outputs: 1,
-            subpops: (0..hidden)
-                .map(|_| {
-                    (0..e.settings.subpop_size)
-                        .map(|_| random_genes(&mut rng, 3, 6.0))
-                        .collect()
-                })
-                .collect(),
-            best: None,
-            champion: None,
-            since_improvement: 0,
-            bursts_since_improvement: 0,
-            pending: None,
-            bursts: 0,
-            evaluations: 0,
-        }
+        let subpops = (0..hidden)
+            .map(|_| random_subpop(&mut rng, e.settings.subpop_size, 3, 6.0))
+            .collect();
+        State::new(2, 1, subpops)
     }
 
     #[test]

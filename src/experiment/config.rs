@@ -117,11 +117,16 @@ impl fmt::Display for Preset {
 impl FromStr for Preset {
     type Err = String;
     fn from_str(s: &str) -> Result<Preset, String> {
-        Preset::ALL.into_iter().find(|p| p.name() == s).ok_or_else(|| {
-            let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
-            format!("unknown preset {s:?} (expected one of {})", names.join(", "))
-        })
+        by_name(s, &Preset::ALL, Preset::name, "preset")
     }
+}
+
+/// The item of `all` called `s`, or an error listing the names.
+fn by_name<T: Copy>(s: &str, all: &[T], name: fn(T) -> &'static str, what: &str) -> Result<T, String> {
+    all.iter().copied().find(|&item| name(item) == s).ok_or_else(|| {
+        let names: Vec<&str> = all.iter().map(|&item| name(item)).collect();
+        format!("unknown {what} {s:?} (expected one of {})", names.join(", "))
+    })
 }
 
 /// Overlays `overrides` onto `base`, table by table.
@@ -264,10 +269,7 @@ impl fmt::Display for GridConfig {
 impl FromStr for GridConfig {
     type Err = String;
     fn from_str(s: &str) -> Result<GridConfig, String> {
-        GridConfig::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| {
-            let names: Vec<&str> = GridConfig::ALL.iter().map(|c| c.name()).collect();
-            format!("unknown configuration {s:?} (expected one of {})", names.join(", "))
-        })
+        by_name(s, &GridConfig::ALL, GridConfig::name, "configuration")
     }
 }
 
