@@ -154,11 +154,22 @@ fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
     use psa_esp::psa::{NetworkFile, SensorSettings, Task};
     let dir = tempfile::tempdir().unwrap();
     let net_path = dir.path().join("damper.json");
-    NetworkFile::new(&spin_damper(), Task::StopRotation, SensorSettings::default(), serde_json::Map::new())
-        .save(&net_path)
-        .unwrap();
+    NetworkFile::new(
+        &spin_damper(),
+        Task::StopRotation,
+        SensorSettings::default(),
+        serde_json::Map::new(),
+    )
+    .save(&net_path)
+    .unwrap();
     let out = dir.path().join("replay");
-    let o = psa_esp(&["replay", net_path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--json"]);
+    let o = psa_esp(&[
+        "replay",
+        net_path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let summary: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     // It stops the spin within a few steps and stays in the box (1 point a
@@ -167,27 +178,64 @@ fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
     assert!(fitness > 25.0 && fitness < 100.0, "{fitness}");
     let csv = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     assert!(csv.starts_with("t,x,y,heading,vx,vy,omega,u0,u1,u2,u3,points"));
-    let last: Vec<f64> = csv.lines().last().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
+    let last: Vec<f64> = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
     assert!(last[6].abs() < 0.05, "the spin is stopped: {last:?}");
     let png = std::fs::read(out.join("trial.png")).unwrap();
-    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 20_000, "{} bytes", png.len());
+    assert!(
+        png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 20_000,
+        "{} bytes",
+        png.len()
+    );
     for svg in ["trial.svg", "trial-animation.svg"] {
         let text = std::fs::read_to_string(out.join(svg)).unwrap();
-        assert!(text.contains("<svg") && text.trim_end().ends_with("</svg>") && text.len() > 20_000, "{svg}");
+        assert!(
+            text.contains("<svg") && text.trim_end().ends_with("</svg>") && text.len() > 20_000,
+            "{svg}"
+        );
     }
-    assert!(std::fs::read_to_string(out.join("trial-animation.svg")).unwrap().contains("<animate"));
+    assert!(std::fs::read_to_string(out.join("trial-animation.svg"))
+        .unwrap()
+        .contains("<animate"));
     // Several trials under noise: mean and sd over the trials.
-    let o = psa_esp(&["replay", net_path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--trials", "4",
-        "--input-noise", "0.05", "--random-init", "--json"]);
+    let o = psa_esp(&[
+        "replay",
+        net_path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--trials",
+        "4",
+        "--input-noise",
+        "0.05",
+        "--random-init",
+        "--json",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let summary: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(summary["fitness_percent_per_trial"].as_array().unwrap().len(), 4);
     // Bad input: task 2 has no random initialisation; a broken network file.
-    let o = psa_esp(&["replay", net_path.to_str().unwrap(), "--task", "2", "--random-init", "--out", out.to_str().unwrap()]);
+    let o = psa_esp(&[
+        "replay",
+        net_path.to_str().unwrap(),
+        "--task",
+        "2",
+        "--random-init",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("task 2"));
     std::fs::write(&net_path, "{").unwrap();
     let o = psa_esp(&["replay", net_path.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("damper.json") && stderr(&o).contains("not valid JSON"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("damper.json") && stderr(&o).contains("not valid JSON"),
+        "{}",
+        stderr(&o)
+    );
 }
