@@ -177,16 +177,16 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             "networks_per_round": args.networks,
             "psa_evaluation": evaluations,
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        say!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        println!("machine: {} ({} cores)", machine.cpu, machine.cores);
-        println!(
+        say!("machine: {} ({} cores)", machine.cpu, machine.cores);
+        say!(
             "physics step, PSA body, dt {} s ({} rounds x {} steps, median):",
             settings.dt, args.rounds, args.steps
         );
-        println!("{:<8} {:>10} {:>10} {:>8}", "backend", "ns/step", "min", "vs ode");
+        say!("{:<8} {:>10} {:>10} {:>8}", "backend", "ns/step", "min", "vs ode");
         for t in &timings {
-            println!(
+            say!(
                 "{:<8} {:>10.1} {:>10.1} {:>7.3}x",
                 t.backend.name(),
                 t.median_ns_per_step,
@@ -194,16 +194,16 @@ pub fn run(args: BenchArgs) -> Result<i32> {
                 t.relative_to_ode
             );
         }
-        println!(
+        say!(
             "PSA network evaluations (7-5-4 random networks, task 1, {} steps each, {} networks per round, median):",
             steps_per_evaluation, args.networks
         );
-        println!(
+        say!(
             "{:<8} {:>14} {:>14} {:>9} {:>16}",
             "backend", "evals/s 1 thr", "evals/s 2 thr", "speed-up", "ns/network-step"
         );
         for e in &evaluations {
-            println!(
+            say!(
                 "{:<8} {:>14.0} {:>14.0} {:>8.2}x {:>16.1}",
                 e.backend.name(),
                 e.evaluations_per_second_1_thread,

@@ -37,18 +37,18 @@ pub fn run(args: CrosscheckArgs) -> Result<i32> {
         args.seed,
     )?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        say!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        println!(
+        say!(
             "{} random thrust sequences x {} steps (seed {}): largest difference from the reference",
             report.sequences, report.steps, report.seed
         );
-        println!(
+        say!(
             "{:<8} {:<34} {:>11} {:>11} {:>11}  {:>9}  result",
             "backend", "reference", "position/m", "heading/rad", "velocity", "tolerance"
         );
         for c in &report.comparisons {
-            println!(
+            say!(
                 "{:<8} {:<34} {:>11.3e} {:>11.3e} {:>11.3e}  {:>9.1e}  {}",
                 c.backend.name(),
                 c.reference,
@@ -60,7 +60,7 @@ pub fn run(args: CrosscheckArgs) -> Result<i32> {
             );
         }
         for c in report.comparisons.iter().filter(|c| c.reference != "ode") {
-            println!(
+            say!(
                 "{:<8} {:<34} {:>11.3e} {:>11.3e} {:>11.3e}  (for information: see RAPIER_TOLERANCE)",
                 c.backend.name(),
                 "ode itself",

@@ -82,9 +82,9 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
     })?;
     bar.finish_and_clear();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&outcome)?);
+        say!("{}", serde_json::to_string_pretty(&outcome)?);
     } else {
-        println!(
+        say!(
             "{} on task {} (seed {}): champion {:.2} % after {} generations, {} evaluations, {} burst mutations, {} hidden neurons; {:.1} s",
             args.preset,
             args.task,
@@ -96,7 +96,7 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
             outcome.champion_hidden,
             outcome.seconds
         );
-        println!("wrote {}", out.display());
+        say!("wrote {}", out.display());
     }
     Ok(0)
 }

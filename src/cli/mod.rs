@@ -1,5 +1,13 @@
 //! The `psa-esp` command line (clap).
 
+/// `println!` to standard output that ends the process quietly when the
+/// reader has gone (`psa-esp ... | head`) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        $crate::cli::write_stdout(format_args!($($arg)*))?
+    };
+}
+
 mod bench;
 mod crosscheck;
 mod evolve;
@@ -116,4 +124,14 @@ pub fn trajectory_csv(
         );
     }
     csv
+}
+
+/// Writes one line to standard output; a closed pipe ends the process with success.
+pub fn write_stdout(args: std::fmt::Arguments) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_fmt(args).and_then(|_| out.write_all(b"\n")).and_then(|_| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        result => result,
+    }
 }

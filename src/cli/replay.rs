@@ -161,14 +161,14 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
             fitness_percent_per_trial: per_trial,
             files,
         };
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        say!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        println!(
+        say!(
             "task {task}, {} backend, {} trial(s): fitness {mean:.2} % (sd {sd:.2}) of the theoretical maximum",
             args.backend, args.trials
         );
         for f in &files {
-            println!("wrote {}", f.display());
+            say!("wrote {}", f.display());
         }
     }
     Ok(0)

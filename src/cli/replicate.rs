@@ -102,7 +102,7 @@ pub fn run(args: ReplicateArgs) -> Result<i32> {
     };
     let summary = replicate(&args.out, &spec, args.jobs, &progress)?;
     progress.bar.finish_and_clear();
-    println!(
+    say!(
         "grid {} ({}): {} runs, {} already finished, {} run now in {:.0} s",
         args.out.display(),
         describe(&spec),
@@ -111,6 +111,6 @@ pub fn run(args: ReplicateArgs) -> Result<i32> {
         summary.ran,
         summary.seconds
     );
-    println!("next: psa-esp report {}", args.out.display());
+    say!("next: psa-esp report {}", args.out.display());
     Ok(0)
 }

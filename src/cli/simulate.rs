@@ -127,7 +127,7 @@ pub fn run(args: SimulateArgs) -> Result<i32> {
             crate::io::write_atomic(path, csv.as_bytes())?;
             eprintln!("wrote {} states to {}", states.len(), path.display());
         }
-        None => print!("{csv}"),
+        None => say!("{}", csv.trim_end()),
     }
     Ok(0)
 }
