@@ -168,8 +168,8 @@ fn evolve_is_bit_identical_for_1_2_and_4_threads() {
 fn evolve_writes_a_champion_that_replays_to_its_recorded_fitness() {
     let dir = tempfile::tempdir().unwrap();
     let config = small_config(dir.path());
-    let out = dir.path().join("run");
     for (preset, task) in [("baseline", "2"), ("hill-climb", "3"), ("max-credit", "1")] {
+        let out = dir.path().join(preset);
         let o = psa_esp(&[
             "evolve",
             "--task",
@@ -198,6 +198,11 @@ fn evolve_writes_a_champion_that_replays_to_its_recorded_fitness() {
         let records = std::fs::read_to_string(out.join("records.csv")).unwrap();
         assert_eq!(records.lines().count(), 9, "header + 8 generations");
         assert_eq!(resolved.problem, PsaSettings::default());
+        // The same directory again: refused, nothing overwritten.
+        let o = psa_esp(&["evolve", "--task", task, "--out", out.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("not empty"));
+        assert_eq!(std::fs::read_to_string(out.join("records.csv")).unwrap(), records);
     }
 }
 

@@ -69,6 +69,12 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("evolve-{}-task{}-seed{}", args.preset, args.task, args.seed)));
+    if out.read_dir().is_ok_and(|mut entries| entries.next().is_some()) {
+        anyhow::bail!(
+            "output directory {} is not empty: results already written are never overwritten; choose another --out",
+            out.display()
+        );
+    }
     let bar = progress_bar(
         config.generations() as u64,
         "{spinner} generation {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
