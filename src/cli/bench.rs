@@ -182,7 +182,9 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         say!("machine: {} ({} cores)", machine.cpu, machine.cores);
         say!(
             "physics step, PSA body, dt {} s ({} rounds x {} steps, median):",
-            settings.dt, args.rounds, args.steps
+            settings.dt,
+            args.rounds,
+            args.steps
         );
         say!("{:<8} {:>10} {:>10} {:>8}", "backend", "ns/step", "min", "vs ode");
         for t in &timings {
@@ -196,11 +198,16 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         }
         say!(
             "PSA network evaluations (7-5-4 random networks, task 1, {} steps each, {} networks per round, median):",
-            steps_per_evaluation, args.networks
+            steps_per_evaluation,
+            args.networks
         );
         say!(
             "{:<8} {:>14} {:>14} {:>9} {:>16}",
-            "backend", "evals/s 1 thr", "evals/s 2 thr", "speed-up", "ns/network-step"
+            "backend",
+            "evals/s 1 thr",
+            "evals/s 2 thr",
+            "speed-up",
+            "ns/network-step"
         );
         for e in &evaluations {
             say!(

@@ -41,11 +41,18 @@ pub fn run(args: CrosscheckArgs) -> Result<i32> {
     } else {
         say!(
             "{} random thrust sequences x {} steps (seed {}): largest difference from the reference",
-            report.sequences, report.steps, report.seed
+            report.sequences,
+            report.steps,
+            report.seed
         );
         say!(
             "{:<8} {:<34} {:>11} {:>11} {:>11}  {:>9}  result",
-            "backend", "reference", "position/m", "heading/rad", "velocity", "tolerance"
+            "backend",
+            "reference",
+            "position/m",
+            "heading/rad",
+            "velocity",
+            "tolerance"
         );
         for c in &report.comparisons {
             say!(

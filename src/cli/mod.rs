@@ -13,6 +13,7 @@ mod crosscheck;
 mod evolve;
 mod replay;
 mod replicate;
+mod report;
 mod simulate;
 
 use std::fmt::Write as _;
@@ -44,6 +45,8 @@ pub enum Command {
     Evolve(evolve::EvolveArgs),
     /// Run the paper's experiment grid (resumable).
     Replicate(replicate::ReplicateArgs),
+    /// Compare a grid's results with the paper's tables: report.md, figures, and CSV or JSON.
+    Report(report::ReportArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
     Replay(replay::ReplayArgs),
     /// Measure physics steps and network evaluations of every backend in one run.
@@ -57,6 +60,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
         Command::Crosscheck(args) => crosscheck::run(args),
         Command::Evolve(args) => evolve::run(args),
         Command::Replicate(args) => replicate::run(args),
+        Command::Report(args) => report::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
     }
@@ -130,7 +134,11 @@ pub fn trajectory_csv(
 pub fn write_stdout(args: std::fmt::Arguments) -> std::io::Result<()> {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
-    match out.write_fmt(args).and_then(|_| out.write_all(b"\n")).and_then(|_| out.flush()) {
+    match out
+        .write_fmt(args)
+        .and_then(|_| out.write_all(b"\n"))
+        .and_then(|_| out.flush())
+    {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
         result => result,
     }

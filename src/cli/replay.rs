@@ -10,7 +10,7 @@ use crate::plots::{write_trial_pictures, TrialPicture};
 use crate::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
 
 /// Key of the random stream of replays.
-const REPLAY_STREAM: u64 = 0x7265_706c_6179; // "replay"
+const REPLAY_STREAM: u64 = 301;
 
 /// Arguments of `replay`.
 #[derive(Debug, clap::Args)]
@@ -165,7 +165,8 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
     } else {
         say!(
             "task {task}, {} backend, {} trial(s): fitness {mean:.2} % (sd {sd:.2}) of the theoretical maximum",
-            args.backend, args.trials
+            args.backend,
+            args.trials
         );
         for f in &files {
             say!("wrote {}", f.display());

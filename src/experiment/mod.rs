@@ -5,9 +5,12 @@ mod config;
 mod evaluator;
 pub mod grid;
 pub mod replicate;
+pub mod report;
 pub mod robustness;
 mod run;
+pub mod stats;
 
 pub use config::{Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};
 pub use evaluator::PsaEvaluator;
+pub use report::{write_report, ReportFormat, ReportOutcome};
 pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles};

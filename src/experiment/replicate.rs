@@ -17,7 +17,7 @@ use super::{run_evolution, EvolveOutcome};
 use crate::psa::NetworkFile;
 
 /// Stream key of the run seeds.
-const RUN_SEED: u64 = 0x7275_6e73_6565_64;
+const RUN_SEED: u64 = 201;
 
 /// The seed a run actually uses: derived from the grid seed, the
 /// configuration and the task, so that runs of different configurations or

@@ -12,6 +12,7 @@
 //! the environment variable `PSA_ESP_FONT`.
 
 mod animation;
+pub mod curves;
 mod font;
 pub mod trial;
 

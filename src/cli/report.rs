@@ -1,0 +1,72 @@
+//! `psa-esp report`: a grid's results beside the paper's tables.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use crate::experiment::report::{write_report, ReportFormat};
+
+/// Arguments of `report`.
+#[derive(Debug, clap::Args)]
+pub struct ReportArgs {
+    /// The grid directory written by `psa-esp replicate` (holds grid.json).
+    pub dir: PathBuf,
+    /// md: write report.md and print it; csv: also report.csv (one row per
+    /// table cell); json: also report.json (the whole report). The figures
+    /// go to DIR/figures/ in every case.
+    #[arg(long, value_enum, default_value_t = ReportFormat::Md)]
+    pub format: ReportFormat,
+}
+
+/// Runs `report`: exit code 0, or 1 when a run folder is damaged or holds
+/// another configuration (the report is written all the same, without it).
+/// A directory that is not a grid is an error (exit code 2).
+pub fn run(args: ReportArgs) -> Result<i32> {
+    let outcome = write_report(&args.dir, args.format)?;
+    if args.format == ReportFormat::Md {
+        say!("{}", outcome.markdown.trim_end());
+    }
+    // With the Markdown on standard output, the paths go to standard error.
+    let mut lines: Vec<String> = outcome
+        .written
+        .iter()
+        .map(|p| format!("wrote {}", p.display()))
+        .collect();
+    if let Some(folder) = outcome.figures.first().and_then(|p| p.parent()) {
+        lines.push(format!(
+            "wrote {} figure files (SVG and PNG) in {}",
+            outcome.figures.len(),
+            folder.display()
+        ));
+    }
+    for line in lines {
+        if args.format == ReportFormat::Md {
+            eprintln!("{line}");
+        } else {
+            say!("{line}");
+        }
+    }
+    eprintln!(
+        "{} of {} runs counted{}",
+        outcome.counted,
+        outcome.expected,
+        if outcome.counted < outcome.expected {
+            " (partial grid: see \"Missing runs\" and \"Problems\" in report.md)"
+        } else {
+            ""
+        }
+    );
+    for problem in &outcome.figure_problems {
+        eprintln!("warning: figure not drawn: {problem}");
+    }
+    for problem in &outcome.problems {
+        eprintln!("problem: {problem}");
+    }
+    if !outcome.problems.is_empty() {
+        eprintln!(
+            "error: {} run folder(s) damaged or holding another configuration; not counted",
+            outcome.problems.len()
+        );
+    }
+    Ok(outcome.exit_code())
+}
