@@ -164,3 +164,59 @@ fn damaged_or_foreign_run_folders_are_reported_and_left_untouched() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("no grid.json"));
 }
+
+#[test]
+fn a_tiny_grid_reports_every_table_and_figure() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("tiny");
+    let o = psa_esp(&[
+        "replicate",
+        "--seeds",
+        "2",
+        "--generations",
+        "3",
+        "--robustness-trials",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = psa_esp(&["report", dir.to_str().unwrap(), "--format", "json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for needle in [
+        "REDUCED GRID",
+        "Table 1",
+        "Table 2",
+        "Table 3",
+        "Table 4",
+        "Table 5",
+        "Table 6",
+        "Table 7",
+        "Burst mutations",
+        "max credit is clearly better",
+        "figures/figure4.png",
+    ] {
+        assert!(md.contains(needle), "report lacks {needle:?}");
+    }
+    assert!(!md.contains("NaN"), "{md}");
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    assert!(report.is_object());
+    let figures: Vec<_> = std::fs::read_dir(dir.join("figures"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    // Figure 4 and one curve per configuration, each as SVG and PNG.
+    assert_eq!(figures.len(), 2 * 10, "{figures:?}");
+    for f in figures.iter().filter(|f| f.extension().unwrap() == "png") {
+        assert!(std::fs::read(f).unwrap().starts_with(b"\x89PNG"), "{}", f.display());
+        let name = f.file_name().unwrap().to_str().unwrap();
+        assert!(md.contains(&format!("figures/{name}")), "{name} not linked");
+    }
+    // A partial grid says what is missing.
+    std::fs::remove_dir_all(dir.join("runs/hill-climb/task3")).unwrap();
+    let o = psa_esp(&["report", dir.to_str().unwrap()]);
+    assert!(o.status.success());
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("PARTIAL GRID") && md.contains("hill-climb"), "{md}");
+}
