@@ -8,7 +8,8 @@ use anyhow::{ensure, Context, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::font::{ensure_font, FONT_FAMILY};
+use super::font::ensure_font;
+use super::output::{draw_legend, font, write_svg_and_png, Drawing};
 
 /// Width of a curve figure in pixels.
 pub const CURVE_WIDTH: u32 = 1000;
@@ -104,35 +105,18 @@ pub fn write_curve_figure(figure: &CurveFigure, dir: &Path, stem: &str) -> Resul
     let svg_path = dir.join(format!("{stem}.svg"));
     let png_path = dir.join(format!("{stem}.png"));
 
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (CURVE_WIDTH, CURVE_HEIGHT)).into_drawing_area();
-        draw(&root, figure).with_context(|| format!("drawing {}", svg_path.display()))?;
-        root.present()
-            .with_context(|| format!("drawing {}", svg_path.display()))?;
-    }
-    crate::io::write_atomic(&svg_path, svg.as_bytes())?;
-
-    // The PNG encoder picks the format from the extension: draw into a
-    // temporary .png beside the target, then rename it into place.
-    let tmp = dir.join(format!(".{stem}.tmp-{}.png", std::process::id()));
-    let drawn = (|| -> Result<()> {
-        let root = BitMapBackend::new(&tmp, (CURVE_WIDTH, CURVE_HEIGHT)).into_drawing_area();
-        draw(&root, figure)?;
-        root.present()?;
-        drop(root);
-        std::fs::rename(&tmp, &png_path)?;
-        Ok(())
-    })();
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    drawn.with_context(|| format!("writing {}", png_path.display()))?;
+    write_svg_and_png(figure, (CURVE_WIDTH, CURVE_HEIGHT), &svg_path, &png_path)?;
     Ok([svg_path, png_path])
 }
 
-fn font(size: f64) -> TextStyle<'static> {
-    (FONT_FAMILY, size).into_font().color(&BLACK)
+impl Drawing for CurveFigure {
+    fn draw<DB>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB: DrawingBackend,
+        DB::ErrorType: 'static,
+    {
+        draw(root, self)
+    }
 }
 
 /// Draws the chart onto `root`.
@@ -180,15 +164,7 @@ where
             .label(&s.label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(3)));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .margin(10)
-        .label_font(font(16.0))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(120, 120, 120))
-        .draw()?;
-    Ok(())
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, 10, 16.0)
 }
 
 #[cfg(test)]

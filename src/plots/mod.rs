@@ -14,6 +14,7 @@
 mod animation;
 pub mod curves;
 mod font;
+mod output;
 pub mod trial;
 
 pub use font::{ensure_font, FONT_ENV_VAR, FONT_FAMILY, FONT_PACKAGE};

@@ -9,7 +9,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::animation;
-use super::font::{ensure_font, FONT_FAMILY};
+use super::font::ensure_font;
+use super::output::{draw_legend, font, write_svg_and_png, Drawing};
 use crate::physics::{wrap_angle, BodyState};
 
 /// Width of the static figure in pixels.
@@ -177,29 +178,11 @@ pub fn write_trial_pictures(picture: &TrialPicture, dir: &Path, stem: &str) -> a
     let png_path = dir.join(format!("{stem}.png"));
     let animation_path = dir.join(format!("{stem}-animation.svg"));
 
-    {
-        let root = SVGBackend::new(&svg_path, (FIGURE_WIDTH, FIGURE_HEIGHT)).into_drawing_area();
-        draw_figure(&root, picture).with_context(|| format!("drawing {}", svg_path.display()))?;
-        root.present()
-            .with_context(|| format!("writing {}", svg_path.display()))?;
-    }
-    {
-        let root = BitMapBackend::new(&png_path, (FIGURE_WIDTH, FIGURE_HEIGHT)).into_drawing_area();
-        draw_figure(&root, picture).with_context(|| format!("drawing {}", png_path.display()))?;
-        root.present()
-            .with_context(|| format!("writing {}", png_path.display()))?;
-    }
+    write_svg_and_png(picture, (FIGURE_WIDTH, FIGURE_HEIGHT), &svg_path, &png_path)?;
     let svg = animation::animation_svg(picture);
-    std::fs::write(&animation_path, svg).with_context(|| format!("writing {}", animation_path.display()))?;
+    crate::io::write_atomic(&animation_path, svg.as_bytes())?;
 
     Ok(vec![svg_path, png_path, animation_path])
-}
-
-/// A text style of the registered font. Use even sizes: plotters' ab_glyph
-/// backend rounds each glyph's vertical offset separately, which for odd sizes
-/// moves some glyphs (the decimal point) by a pixel.
-fn font(size: f64) -> TextStyle<'static> {
-    (FONT_FAMILY, size).into_font().color(&BLACK)
 }
 
 /// A tick label with `decimals` decimals and no "-0.00".
@@ -208,6 +191,16 @@ fn tick_label(value: f64, decimals: usize) -> String {
     match text.strip_prefix('-') {
         Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_string(),
         _ => text,
+    }
+}
+
+impl Drawing for TrialPicture<'_> {
+    fn draw<DB>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
+    where
+        DB: DrawingBackend,
+        DB::ErrorType: 'static,
+    {
+        draw_figure(root, self)
     }
 }
 
@@ -350,15 +343,7 @@ where
         .label(format!("end (t = {:.2} s)", picture.duration()))
         .legend(|(x, y)| TriangleMarker::new((x + 10, y), 7, END_COLOR.filled()));
 
-    chart
-        .configure_series_labels()
-        .position(emptiest_corner(picture, xs, ys))
-        .margin(10)
-        .label_font(font(16.0))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(120, 120, 120))
-        .draw()?;
-    Ok(())
+    draw_legend(&mut chart, emptiest_corner(picture, xs, ys), 10, 16.0)
 }
 
 /// The plot corner with the fewest path points nearby, for the legend.
@@ -541,15 +526,7 @@ where
         ))?
         .label("angular velocity ω (rad/s)")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], OMEGA_COLOR.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .margin(8)
-        .label_font(font(14.0))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(120, 120, 120))
-        .draw()?;
-    Ok(())
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 8, 14.0)
 }
 
 #[cfg(test)]

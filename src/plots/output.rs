@@ -1,0 +1,85 @@
+//! What every figure shares: the text style, the legend box, and writing a
+//! figure as SVG and PNG atomically.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::font::FONT_FAMILY;
+
+/// A figure that can be drawn on any plotters backend.
+pub(crate) trait Drawing {
+    /// Draws the whole figure onto `root`.
+    fn draw<DB>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
+    where
+        DB: DrawingBackend,
+        DB::ErrorType: 'static;
+}
+
+/// A text style of the registered font. Use even sizes: plotters' ab_glyph
+/// backend rounds each glyph's vertical offset separately, which for odd sizes
+/// moves some glyphs (the decimal point) by a pixel.
+pub(crate) fn font(size: f64) -> TextStyle<'static> {
+    (FONT_FAMILY, size).into_font().color(&BLACK)
+}
+
+/// Draws the legend of `chart`'s labelled series in a framed, translucent box.
+pub(crate) fn draw_legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    margin: u32,
+    font_size: f64,
+) -> Result<()>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    CT: CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .margin(margin)
+        .label_font(font(font_size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(120, 120, 120))
+        .draw()?;
+    Ok(())
+}
+
+/// Writes `drawing` of `size` pixels as SVG and PNG, each atomically: the
+/// SVG drawn into memory, the PNG into a temporary `.png` beside its target
+/// (the encoder picks the format from the extension), then renamed.
+pub(crate) fn write_svg_and_png(
+    drawing: &impl Drawing,
+    size: (u32, u32),
+    svg_path: &Path,
+    png_path: &Path,
+) -> Result<()> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        drawing
+            .draw(&root)
+            .with_context(|| format!("drawing {}", svg_path.display()))?;
+        root.present()
+            .with_context(|| format!("drawing {}", svg_path.display()))?;
+    }
+    crate::io::write_atomic(svg_path, svg.as_bytes())?;
+    let dir = png_path.parent().unwrap_or(Path::new("."));
+    let stem = png_path.file_stem().map_or("figure".into(), |s| s.to_string_lossy());
+    let tmp = dir.join(format!(".{stem}.tmp-{}.png", std::process::id()));
+    let drawn = (|| -> Result<()> {
+        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
+        drawing.draw(&root)?;
+        root.present()?;
+        drop(root);
+        std::fs::rename(&tmp, png_path)?;
+        Ok(())
+    })();
+    if drawn.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    drawn.with_context(|| format!("writing {}", png_path.display()))
+}
