@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
+use crate::experiment::robustness::TrialSummary;
 use crate::physics::BackendKind;
 use crate::plots::{write_trial_pictures, TrialPicture};
 use crate::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
@@ -64,16 +65,6 @@ struct ReplaySummary {
     files: Vec<PathBuf>,
 }
 
-fn mean_and_sd(values: &[f64]) -> (f64, f64) {
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    if values.len() < 2 {
-        return (mean, 0.0);
-    }
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, var.sqrt())
-}
-
 fn write_outputs(dir: &Path, record: &TrialRecord, settings: &PsaSettings, title: String) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
     let csv = super::trajectory_csv(&record.states, settings.physics.dt, ",u0,u1,u2,u3,points", |i| {
@@ -129,7 +120,7 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
         let record = (trial == 0).then_some(&mut first);
         per_trial.push(100.0 * runner.run_trial(&network, &mut rng, record)? / maximum);
     }
-    let (mean, sd) = mean_and_sd(&per_trial);
+    let TrialSummary { mean, sd } = TrialSummary::of(&per_trial);
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args
             .network

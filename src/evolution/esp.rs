@@ -7,7 +7,7 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use super::operators::{cauchy, crossover, mutate_one_gene, random_genes};
-use super::{check_count, check_positive, check_probability, evaluate_all, purpose};
+use super::{best_of, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose};
 use super::{Champion, Evaluator, GenerationRecord, LesionOutcome, RunResult};
 use crate::network::Network;
 use crate::rng::stream;
@@ -278,11 +278,7 @@ impl Esp {
         state.evaluations += networks.len() as u64;
 
         // The generation's best network updates the champion and the search's best.
-        let (top, &top_fitness) =
-            fitness.iter().enumerate().fold(
-                (0, &f64::NEG_INFINITY),
-                |acc, (j, f)| if *f > *acc.1 { (j, f) } else { acc },
-            );
+        let (top, top_fitness) = best_of(&fitness);
         if state.champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
             state.champion = Some(Champion {
                 network: networks[top].clone(),
@@ -312,11 +308,11 @@ impl Esp {
                 self.recombine(subpop, generation, i);
             }
         }
-        let n = fitness.len() as f64;
+        let (min, mean) = min_and_mean(&fitness);
         Ok(GenerationRecord {
             generation,
-            min: fitness.iter().copied().fold(f64::INFINITY, f64::min),
-            mean: fitness.iter().sum::<f64>() / n,
+            min,
+            mean,
             max: top_fitness,
             best: state.best.as_ref().map(|(_, f)| *f),
             champion: state.champion.as_ref().map_or(f64::NAN, |c| c.fitness),
@@ -462,11 +458,7 @@ impl Esp {
         let fitness = evaluate_all(evaluator, &variants, self.seed, &[purpose::LESION, generation as u64])?;
         state.evaluations += variants.len() as u64;
         let whole = fitness[0];
-        let (neuron, kept) =
-            fitness[1..].iter().enumerate().fold(
-                (0, f64::NEG_INFINITY),
-                |acc, (k, &f)| if f > acc.1 { (k, f) } else { acc },
-            );
+        let (neuron, kept) = best_of(&fitness[1..]);
         // For positive fitness this is kept >= threshold x whole.
         let redundant = kept >= whole - (1.0 - self.settings.lesion_threshold) * whole.abs();
         Ok(if best.hidden() > 1 && redundant {

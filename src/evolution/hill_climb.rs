@@ -5,7 +5,7 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use super::operators::{cauchy, random_genes};
-use super::{check_count, check_positive, check_probability, evaluate_all, purpose};
+use super::{best_of, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose};
 use super::{Champion, Evaluator, GenerationRecord, RunResult};
 use crate::network::Network;
 use crate::rng::{stream, Stream};
@@ -171,11 +171,7 @@ impl HillClimb {
                 .collect::<Result<Vec<_>, _>>()?;
             let fitness = evaluate_all(evaluator, &candidates, self.seed, &[purpose::EVALUATE, cycle as u64])?;
             evaluations += candidates.len() as u64;
-            let (top, top_fitness) =
-                fitness.iter().enumerate().fold(
-                    (0, f64::NEG_INFINITY),
-                    |acc, (j, &f)| if f > acc.1 { (j, f) } else { acc },
-                );
+            let (top, top_fitness) = best_of(&fitness);
             if champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
                 champion = Some(Champion {
                     network: candidates[top].clone(),
@@ -187,10 +183,11 @@ impl HillClimb {
                 base = candidates[top].clone();
                 base_fitness = top_fitness;
             }
+            let (min, mean) = min_and_mean(&fitness);
             let record = GenerationRecord {
                 generation: cycle,
-                min: fitness.iter().copied().fold(f64::INFINITY, f64::min),
-                mean: fitness.iter().sum::<f64>() / fitness.len() as f64,
+                min,
+                mean,
                 max: top_fitness,
                 best: Some(base_fitness),
                 champion: champion.as_ref().map_or(f64::NAN, |c| c.fitness),

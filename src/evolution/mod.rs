@@ -82,3 +82,17 @@ pub(crate) fn check_count(name: &str, n: usize, min: usize) -> Result<(), String
         Err(format!("{name} must be >= {min}, got {n}"))
     }
 }
+
+/// The first position of the highest fitness, and that fitness.
+pub(crate) fn best_of(fitness: &[f64]) -> (usize, f64) {
+    fitness.iter().enumerate().fold(
+        (0, f64::NEG_INFINITY),
+        |best, (j, &f)| if f > best.1 { (j, f) } else { best },
+    )
+}
+
+/// The lowest and the mean fitness.
+pub(crate) fn min_and_mean(fitness: &[f64]) -> (f64, f64) {
+    let min = fitness.iter().copied().fold(f64::INFINITY, f64::min);
+    (min, fitness.iter().sum::<f64>() / fitness.len() as f64)
+}

@@ -26,14 +26,11 @@ pub struct TrialSummary {
 impl TrialSummary {
     /// The summary of `values` (sd 0 for a single value).
     pub fn of(values: &[f64]) -> TrialSummary {
-        let n = values.len() as f64;
-        let mean = values.iter().sum::<f64>() / n;
-        let sd = if values.len() > 1 {
-            (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-        } else {
-            0.0
-        };
-        TrialSummary { mean, sd }
+        let (mean, sd) = super::stats::mean_sd(values);
+        TrialSummary {
+            mean,
+            sd: if values.len() > 1 { sd } else { 0.0 },
+        }
     }
 }
 
