@@ -14,6 +14,7 @@ pub mod evolution;
 pub mod experiment;
 pub mod io;
 pub mod network;
+pub mod numeric;
 pub mod ode;
 pub mod physics;
 pub mod plots;

@@ -26,10 +26,11 @@ pub enum NetworkError {
     },
 }
 
-/// The logistic sigmoid 1 / (1 + e^-x).
+/// The logistic sigmoid 1 / (1 + e^-x), with our own `exp` (see
+/// [`crate::numeric`]) so that every path computes the same bits.
 #[inline]
 pub fn sigmoid(x: f64) -> f64 {
-    1.0 / (1.0 + (-x).exp())
+    crate::numeric::sigmoid(x)
 }
 
 fn check_sizes(inputs: usize, outputs: usize) -> Result<(), NetworkError> {
@@ -133,6 +134,11 @@ impl Network {
 
     /// Computes the outputs for `input` into `output`; allocates nothing.
     ///
+    /// The order of operations is part of the definition (the batched path
+    /// in `psa::batch` repeats it lane by lane): each hidden unit sums
+    /// `w[0] x[0] + w[1] x[1] + ...` from the left; each output starts at 0
+    /// and adds the hidden units' contributions in neuron order.
+    ///
     /// # Panics
     /// If the slices' lengths differ from the network's inputs and outputs.
     pub fn activate(&self, input: &[f64], output: &mut [f64]) {
@@ -145,7 +151,10 @@ impl Network {
                 continue;
             }
             let (w_in, w_out) = neuron.split_at(self.inputs);
-            let activation: f64 = w_in.iter().zip(input).map(|(w, x)| w * x).sum();
+            let mut activation = w_in[0] * input[0];
+            for (w, x) in w_in.iter().zip(input).skip(1) {
+                activation += w * x;
+            }
             let h = sigmoid(activation);
             for (o, w) in output.iter_mut().zip(w_out) {
                 *o += h * w;

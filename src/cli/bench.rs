@@ -1,16 +1,21 @@
-//! `psa-esp bench`: ns per physics step of every backend (interleaved so
-//! that machine noise hits them alike) and PSA network evaluations per
-//! second per backend on 1 and 2 threads, all measured in one run.
+//! `psa-esp bench`: in one run, ns per physics step of every backend
+//! (interleaved so that machine noise hits them alike), ns per
+//! network-step and evaluations per second of every evaluation path (ode,
+//! native scalar, native batched on each SIMD level, rapier) on 1 and 2
+//! threads, and the 2-thread speed-up and algorithm overhead of `evolve`
+//! and `replicate` (see [`super::bench_runs`]).
 
 use std::time::Instant;
 
 use anyhow::Result;
 use serde::Serialize;
 
+use super::bench_runs::{algorithm_overhead, evolve_scaling, replicate_scaling};
 use crate::evolution::evaluate_all;
 use crate::evolution::operators::random_genes;
 use crate::experiment::PsaEvaluator;
 use crate::network::Network;
+use crate::numeric::SimdLevel;
 use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, PhysicsBackend};
 use crate::psa::{BodySettings, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
 
@@ -24,17 +29,59 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..))]
     pub rounds: u64,
     /// Networks per round of the evaluation benchmark.
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..))]
     pub networks: u64,
+    /// Generations of the `evolve` and `replicate` scaling runs.
+    #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u64).range(2..))]
+    pub generations: u64,
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
 }
 
-/// One backend's speed at whole network evaluations (one 500-step trial each).
+/// A way of evaluating networks: a backend, and on `native` the scalar
+/// reference or the batched path on one SIMD level.
+#[derive(Debug, Clone, Copy, Serialize)]
+struct EvaluationPath {
+    backend: BackendKind,
+    /// The batched path's SIMD level; `None` for the scalar path.
+    simd: Option<SimdLevel>,
+}
+
+impl EvaluationPath {
+    fn label(&self) -> String {
+        match (self.backend, self.simd) {
+            (BackendKind::Native, None) => "native scalar".into(),
+            (BackendKind::Native, Some(level)) => format!("native batched {level}"),
+            (backend, _) => backend.name().into(),
+        }
+    }
+
+    /// ode, native scalar, native batched on every level the CPU has, rapier.
+    fn all() -> Vec<EvaluationPath> {
+        let mut paths = Vec::new();
+        for backend in BackendKind::available() {
+            paths.push(EvaluationPath { backend, simd: None });
+            if backend == BackendKind::Native {
+                paths.extend(
+                    SimdLevel::ALL
+                        .into_iter()
+                        .filter(|l| l.is_supported())
+                        .map(|level| EvaluationPath {
+                            backend,
+                            simd: Some(level),
+                        }),
+                );
+            }
+        }
+        paths
+    }
+}
+
+/// One path's speed at whole network evaluations (one 500-step trial each).
 #[derive(Debug, Serialize)]
 struct EvaluationTiming {
-    backend: BackendKind,
+    path: EvaluationPath,
     evaluations_per_second_1_thread: f64,
     evaluations_per_second_2_threads: f64,
     speedup_2_threads: f64,
@@ -57,12 +104,12 @@ fn random_networks(count: u64) -> Result<Vec<Network>> {
 
 /// Evaluations per second of `networks` on task 1 with `threads` threads
 /// (median of `rounds` rounds).
-fn evaluations_per_second(kind: BackendKind, networks: &[Network], threads: usize, rounds: u64) -> Result<f64> {
+fn evaluations_per_second(path: EvaluationPath, networks: &[Network], threads: usize, rounds: u64) -> Result<f64> {
     let settings = PsaSettings {
-        backend: kind,
+        backend: path.backend,
         ..PsaSettings::default()
     };
-    let evaluator = PsaEvaluator::new(settings, Task::StopRotation)?;
+    let evaluator = PsaEvaluator::new(settings, Task::StopRotation)?.with_batching(path.simd);
     let pool = crate::ode::thread_pool(threads)?;
     let mut rates = Vec::new();
     for round in 0..rounds {
@@ -153,13 +200,13 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         .collect();
     let networks = random_networks(args.networks)?;
     let steps_per_evaluation = PsaSettings::default().steps as f64;
-    let evaluations = kinds
-        .iter()
-        .map(|&backend| {
-            let one = evaluations_per_second(backend, &networks, 1, args.rounds)?;
-            let two = evaluations_per_second(backend, &networks, 2, args.rounds)?;
+    let evaluations = EvaluationPath::all()
+        .into_iter()
+        .map(|path| {
+            let one = evaluations_per_second(path, &networks, 1, args.rounds)?;
+            let two = evaluations_per_second(path, &networks, 2, args.rounds)?;
             Ok(EvaluationTiming {
-                backend,
+                path,
                 evaluations_per_second_1_thread: one,
                 evaluations_per_second_2_threads: two,
                 speedup_2_threads: two / one,
@@ -167,6 +214,10 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    let generations = args.generations as usize;
+    let evolve = evolve_scaling(generations, args.rounds)?;
+    let replicate = replicate_scaling(generations, args.rounds)?;
+    let overhead = algorithm_overhead(generations, args.rounds)?;
     let machine = machine();
     if args.json {
         let out = serde_json::json!({
@@ -176,10 +227,19 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             "physics_step": timings,
             "networks_per_round": args.networks,
             "psa_evaluation": evaluations,
+            "simd_level_in_use": SimdLevel::detect(),
+            "evolve": evolve,
+            "replicate": replicate,
+            "algorithm_overhead": overhead,
         });
         say!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        say!("machine: {} ({} cores)", machine.cpu, machine.cores);
+        say!(
+            "machine: {} ({} cores); batched path runs on {}",
+            machine.cpu,
+            machine.cores,
+            SimdLevel::detect()
+        );
         say!(
             "physics step, PSA body, dt {} s ({} rounds x {} steps, median):",
             settings.dt,
@@ -202,8 +262,8 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             args.networks
         );
         say!(
-            "{:<8} {:>14} {:>14} {:>9} {:>16}",
-            "backend",
+            "{:<22} {:>14} {:>14} {:>9} {:>16}",
+            "path",
             "evals/s 1 thr",
             "evals/s 2 thr",
             "speed-up",
@@ -211,14 +271,29 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         );
         for e in &evaluations {
             say!(
-                "{:<8} {:>14.0} {:>14.0} {:>8.2}x {:>16.1}",
-                e.backend.name(),
+                "{:<22} {:>14.0} {:>14.0} {:>8.2}x {:>16.1}",
+                e.path.label(),
                 e.evaluations_per_second_1_thread,
                 e.evaluations_per_second_2_threads,
                 e.speedup_2_threads,
                 e.ns_per_network_step_1_thread
             );
         }
+        for (what, s) in [("evolve", &evolve), ("replicate", &replicate)] {
+            say!(
+                "{what}: {}: {:.3} s on 1 thread, {:.3} s on 2 threads (median of {}): speed-up {:.2}x",
+                s.description,
+                s.seconds_1_thread,
+                s.seconds_2_threads,
+                s.rounds,
+                s.speedup
+            );
+        }
+        say!(
+            "algorithm overhead (everything but network evaluation, 1 thread): {:.2} % of generation time ({})",
+            overhead.percent,
+            overhead.description
+        );
     }
     Ok(0)
 }

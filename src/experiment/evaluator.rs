@@ -4,16 +4,39 @@ use anyhow::Result;
 
 use crate::evolution::Evaluator;
 use crate::network::Network;
-use crate::psa::{PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
+use crate::numeric::SimdLevel;
+use crate::physics::BackendKind;
+use crate::psa::batch::LANES;
+use crate::psa::{BatchRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use crate::rng::Stream;
 
 /// Scores a network by its fitness on a task (in % of the theoretical
 /// maximum, the mean over `settings.trials` trials). Each worker thread
-/// owns one physics world, reused between evaluations.
+/// owns one physics world, reused between evaluations. On the `native`
+/// backend, networks are evaluated in lockstep by the batched SIMD path
+/// ([`BatchRunner`]), which gives the scalar path's results bit for bit.
 #[derive(Debug, Clone)]
 pub struct PsaEvaluator {
     settings: PsaSettings,
     task: Task,
+    /// The batched runner, built once and cloned into every worker.
+    batch: Option<BatchRunner>,
+}
+
+/// A worker thread's state: the scalar runner (made when first needed: the
+/// batched path needs it only to report errors), and the batched one on `native`.
+pub struct PsaWorker {
+    scalar: Option<TrialRunner>,
+    batch: Option<BatchRunner>,
+}
+
+impl PsaEvaluator {
+    fn scalar<'w>(&self, worker: &'w mut PsaWorker) -> Result<&'w mut TrialRunner> {
+        if worker.scalar.is_none() {
+            worker.scalar = Some(TrialRunner::new(&self.settings, self.task)?);
+        }
+        Ok(worker.scalar.as_mut().expect("just made"))
+    }
 }
 
 impl PsaEvaluator {
@@ -21,22 +44,68 @@ impl PsaEvaluator {
     pub fn new(settings: PsaSettings, task: Task) -> Result<PsaEvaluator> {
         // Building one runner checks every setting (and random init vs task) up front.
         TrialRunner::new(&settings, task)?;
-        Ok(PsaEvaluator { settings, task })
+        let batch = match settings.backend {
+            BackendKind::Native => Some(BatchRunner::new(&settings, task)?),
+            _ => None,
+        };
+        Ok(PsaEvaluator { settings, task, batch })
+    }
+
+    /// The same evaluator on `native` with the batched path on `level`, or
+    /// with `None` the scalar reference: for benchmarks and cross-checks
+    /// (every choice gives the same results). Other backends stay scalar.
+    pub fn with_batching(mut self, level: Option<SimdLevel>) -> PsaEvaluator {
+        self.batch = match (self.batch.take(), level) {
+            (Some(batch), Some(level)) => Some(batch.with_level(level)),
+            (Some(_), None) => None,
+            (None, _) => BatchRunner::new(&self.settings, self.task)
+                .ok()
+                .zip(level)
+                .map(|(b, l)| b.with_level(l)),
+        };
+        self
     }
 }
 
 impl Evaluator for PsaEvaluator {
-    type Worker = TrialRunner;
+    type Worker = PsaWorker;
     fn inputs(&self) -> usize {
         INPUT_COUNT
     }
     fn outputs(&self) -> usize {
         THRUSTER_COUNT
     }
-    fn worker(&self) -> Result<TrialRunner> {
-        Ok(TrialRunner::new(&self.settings, self.task)?)
+    fn worker(&self) -> Result<PsaWorker> {
+        Ok(PsaWorker {
+            // ODE worlds belong to their thread: make the scalar runner here.
+            scalar: match self.batch {
+                None => Some(TrialRunner::new(&self.settings, self.task)?),
+                Some(_) => None,
+            },
+            batch: self.batch.clone(),
+        })
     }
-    fn evaluate(&self, runner: &mut TrialRunner, network: &Network, rng: &mut Stream) -> Result<f64> {
-        Ok(runner.evaluate(network, rng)?)
+    fn evaluate(&self, worker: &mut PsaWorker, network: &Network, rng: &mut Stream) -> Result<f64> {
+        Ok(self.scalar(worker)?.evaluate(network, rng)?)
+    }
+    fn batch_size(&self) -> usize {
+        if self.batch.is_some() {
+            LANES
+        } else {
+            1
+        }
+    }
+    fn evaluate_batch(&self, worker: &mut PsaWorker, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>> {
+        match &worker.batch {
+            Some(batch) => Ok(batch.evaluate(networks, rngs)?),
+            None => {
+                let scalar = self.scalar(worker)?;
+                networks
+                    .iter()
+                    .zip(rngs)
+                    .map(|(network, rng)| Ok(scalar.evaluate(network, rng)?))
+                    .collect()
+            }
+        }
     }
 }

@@ -6,13 +6,18 @@
 //! that ODE would reject is validated here, in Rust, before the call and
 //! reported as an [`OdeError`]. Together with `ode-sys` this module holds all
 //! of the project's `unsafe` code.
+//!
+//! [`BareOdeLoop`] is the bare sequence of ODE calls of one PSA step, a
+//! benchmark reference for the overhead of this wrapper and the ODE backend.
 
+mod bare;
 mod error;
 mod mass;
 mod messages;
 mod runtime;
 mod world;
 
+pub use bare::{BareOdeLoop, BareStepper, RawBodyState};
 pub use error::OdeError;
 pub use mass::Mass;
 pub use messages::{recent_messages, OdeMessage, OdeMessageKind};

@@ -84,8 +84,19 @@ impl World {
 
     /// Advances the world by `dt` seconds with ODE's exact `dWorldStep`.
     pub fn step(&self, dt: f64) -> Result<(), OdeError> {
-        check_positive("time step dt", dt)?;
-        // SAFETY: the world is live and dt > 0, which dWorldStep asserts.
+        // dWorldStep asserts dt > 0.
+        self.step_prechecked(check_positive("time step dt", dt)?)
+    }
+
+    /// [`World::step`] without re-checking `dt`, for a caller that checked
+    /// it once when it was set (`OdeBackend` validates its `StepSettings` at
+    /// construction and never changes them). A `dt <= 0` or NaN here would
+    /// not be undefined behaviour but would make ODE abort the process, hence
+    /// crate-private, with the check kept in debug builds.
+    #[inline]
+    pub(crate) fn step_prechecked(&self, dt: f64) -> Result<(), OdeError> {
+        debug_assert!(dt.is_finite() && dt > 0.0, "time step dt {dt} must be finite and > 0");
+        // SAFETY: the world is live; the caller guarantees dt > 0.
         let ok = unsafe { ode_sys::dWorldStep(self.handle.id, dt) };
         if ok == 0 {
             return Err(OdeError::CallFailed { call: "dWorldStep" });
@@ -93,10 +104,11 @@ impl World {
         Ok(())
     }
 
-    /// Advances the world by `dt` seconds with ODE's iterative `dWorldQuickStep`.
-    pub fn quick_step(&self, dt: f64) -> Result<(), OdeError> {
-        check_positive("time step dt", dt)?;
-        // SAFETY: the world is live and dt > 0, which dWorldQuickStep asserts.
+    /// [`World::quick_step`] without re-checking `dt`; see [`World::step_prechecked`].
+    #[inline]
+    pub(crate) fn quick_step_prechecked(&self, dt: f64) -> Result<(), OdeError> {
+        debug_assert!(dt.is_finite() && dt > 0.0, "time step dt {dt} must be finite and > 0");
+        // SAFETY: the world is live; the caller guarantees dt > 0.
         let ok = unsafe { ode_sys::dWorldQuickStep(self.handle.id, dt) };
         if ok == 0 {
             return Err(OdeError::CallFailed {
@@ -104,6 +116,12 @@ impl World {
             });
         }
         Ok(())
+    }
+
+    /// Advances the world by `dt` seconds with ODE's iterative `dWorldQuickStep`.
+    pub fn quick_step(&self, dt: f64) -> Result<(), OdeError> {
+        // dWorldQuickStep asserts dt > 0.
+        self.quick_step_prechecked(check_positive("time step dt", dt)?)
     }
 
     /// Creates a dynamic body at the origin, at rest, with ODE's default mass.
@@ -158,6 +176,7 @@ impl Drop for Body {
     }
 }
 
+#[inline]
 fn copy3(ptr: *const f64) -> [f64; 3] {
     // SAFETY: callers pass a pointer ODE returned for a live body, which
     // points at (at least) 3 consecutive dReal values.
@@ -217,12 +236,14 @@ impl Body {
     }
 
     /// Position of the body's origin.
+    #[inline]
     pub fn position(&self) -> [f64; 3] {
         // SAFETY: the body is live; ODE returns a pointer to its dVector3.
         copy3(unsafe { ode_sys::dBodyGetPosition(self.id) })
     }
 
     /// Orientation quaternion (w, x, y, z).
+    #[inline]
     pub fn quaternion(&self) -> [f64; 4] {
         // SAFETY: the body is live; ODE returns a pointer to its dQuaternion.
         let q = unsafe { ode_sys::dBodyGetQuaternion(self.id) };
@@ -231,12 +252,14 @@ impl Body {
     }
 
     /// Linear velocity.
+    #[inline]
     pub fn linear_velocity(&self) -> [f64; 3] {
         // SAFETY: the body is live; ODE returns a pointer to its dVector3.
         copy3(unsafe { ode_sys::dBodyGetLinearVel(self.id) })
     }
 
     /// Angular velocity.
+    #[inline]
     pub fn angular_velocity(&self) -> [f64; 3] {
         // SAFETY: the body is live; ODE returns a pointer to its dVector3.
         copy3(unsafe { ode_sys::dBodyGetAngularVel(self.id) })
@@ -246,11 +269,42 @@ impl Body {
     /// frame (relative to the body origin). ODE clears accumulated forces
     /// after each step.
     pub fn add_rel_force_at_rel_pos(&self, force: [f64; 3], point: [f64; 3]) -> Result<(), OdeError> {
-        let [fx, fy, fz] = check_finite("force", force)?;
-        let [px, py, pz] = check_finite("force application point", point)?;
-        // SAFETY: the body is live; the values are finite.
-        unsafe { ode_sys::dBodyAddRelForceAtRelPos(self.id, fx, fy, fz, px, py, pz) };
+        let force = check_finite("force", force)?;
+        let point = check_finite("force application point", point)?;
+        self.add_rel_force_at_rel_pos_prechecked(force, point);
         Ok(())
+    }
+
+    /// [`Body::add_rel_force_at_rel_pos`] without re-checking the values, for
+    /// a caller that has proved them finite (`OdeBackend`: a finite force at
+    /// full command, from a validated model, times a thrust that
+    /// `validate_thrust` put in [0, 1], at a finite precomputed arm). A
+    /// non-finite value here would not be undefined behaviour (ODE only does
+    /// arithmetic with it) but would turn the state into NaN and make a later
+    /// step abort the process, hence crate-private, with the check kept in
+    /// debug builds.
+    #[inline]
+    pub(crate) fn add_rel_force_at_rel_pos_prechecked(&self, force: [f64; 3], point: [f64; 3]) {
+        debug_assert!(
+            force.iter().chain(&point).all(|v| v.is_finite()),
+            "force {force:?} at {point:?} must be finite"
+        );
+        let ([fx, fy, fz], [px, py, pz]) = (force, point);
+        // SAFETY: the body is live; ODE accepts any values here, and finite
+        // ones (the caller's guarantee) keep the body's state finite.
+        unsafe { ode_sys::dBodyAddRelForceAtRelPos(self.id, fx, fy, fz, px, py, pz) };
+    }
+
+    /// The raw ODE id of the body, for [`super::bare`] (the benchmark
+    /// reference) only. Valid while `self` lives.
+    pub(crate) fn raw_id(&self) -> ode_sys::dBodyID {
+        self.id
+    }
+
+    /// The raw ODE id of the body's world, for [`super::bare`] only. Valid
+    /// while `self` lives (the body keeps its world alive).
+    pub(crate) fn raw_world_id(&self) -> ode_sys::dWorldID {
+        self._world.id
     }
 
     /// ODE's gyroscopic term (on by default).

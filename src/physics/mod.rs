@@ -20,7 +20,7 @@ pub use crosscheck::{
     Tolerance,
 };
 pub use model::{MassPart, MassProperties, RigidBodyModel, Thruster};
-pub use native::{NativeBackend, RotationRule};
+pub use native::{NativeBackend, PlanarBody, PlanarState, RotationRule};
 pub use ode_backend::OdeBackend;
 #[cfg(feature = "rapier")]
 pub use rapier_backend::RapierBackend;
@@ -83,16 +83,9 @@ impl BodyState {
     }
 }
 
-/// Wraps an angle to (-pi, pi].
+/// Wraps an angle to (-pi, pi] (exactly as `angle % TAU` and one correction).
 pub fn wrap_angle(angle: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let mut a = angle % TAU;
-    if a > PI {
-        a -= TAU;
-    } else if a <= -PI {
-        a += TAU;
-    }
-    a
+    crate::numeric::wrap_angle(angle)
 }
 
 /// ODE's stepper.
@@ -235,8 +228,13 @@ pub trait PhysicsBackend {
     fn kind(&self) -> BackendKind;
     /// Puts the body in `state` (forgetting any pending force).
     fn reset(&mut self, state: &BodyState) -> Result<(), PhysicsError>;
-    /// The current state.
-    fn state(&self) -> BodyState;
+    /// The current state as the engine keeps it (quaternion, no heading
+    /// angle): what a controller step reads.
+    fn planar_state(&self) -> PlanarState<f64>;
+    /// The current state, its heading computed from the quaternion.
+    fn state(&self) -> BodyState {
+        self.planar_state().to_body_state()
+    }
     /// Advances one time step with thruster commands `thrust` (one per
     /// thruster, each in [0, 1]; thruster i pushes with `thrust[i] * max_force`).
     fn step(&mut self, thrust: &[f64]) -> Result<(), PhysicsError>;

@@ -28,7 +28,7 @@ use rapier2d_f64::math::{Pose, Real, Vector};
 use rapier2d_f64::pipeline::PhysicsPipeline;
 
 use super::{
-    validate_thrust, wrap_angle, BackendKind, BodyState, MassPart, MassProperties, PhysicsBackend, PhysicsError,
+    validate_thrust, BackendKind, BodyState, MassPart, MassProperties, PhysicsBackend, PhysicsError, PlanarState,
     RigidBodyModel, StepSettings,
 };
 
@@ -195,16 +195,15 @@ impl PhysicsBackend for RapierBackend {
         Ok(())
     }
 
-    fn state(&self) -> BodyState {
+    fn planar_state(&self) -> PlanarState<f64> {
         let body = &self.world.bodies[self.body];
         let p = body.translation();
         let v = body.linvel();
-        BodyState {
-            x: p.x,
-            y: p.y,
-            heading: wrap_angle(body.rotation().angle()),
-            vx: v.x,
-            vy: v.y,
+        let half = 0.5 * body.rotation().angle();
+        PlanarState {
+            position: [p.x, p.y],
+            velocity: [v.x, v.y],
+            quaternion: [half.cos(), half.sin()],
             omega: body.angvel(),
         }
     }
@@ -247,7 +246,7 @@ impl PhysicsBackend for RapierBackend {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::{NativeBackend, OdeBackend, RotationRule};
+    use crate::physics::{wrap_angle, NativeBackend, OdeBackend, RotationRule};
     use crate::psa::BodySettings;
 
     fn model() -> RigidBodyModel {

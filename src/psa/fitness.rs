@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::numeric::Real;
+
 /// Which fitness function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -44,19 +46,20 @@ impl Default for FitnessSettings {
 }
 
 /// One step's error relative to the target: position (m), wrapped heading
-/// error (rad), angular velocity now and one step before (rad/s).
+/// error (rad), angular velocity now and one step before (rad/s). Generic
+/// over [`Real`] for the batched path.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepError {
+pub struct StepError<R = f64> {
     /// x relative to the target.
-    pub x: f64,
+    pub x: R,
     /// y relative to the target.
-    pub y: f64,
+    pub y: R,
     /// Heading minus target heading, wrapped to (-pi, pi].
-    pub heading: f64,
+    pub heading: R,
     /// Angular velocity at this step.
-    pub omega: f64,
+    pub omega: R,
     /// Angular velocity at the step before.
-    pub previous_omega: f64,
+    pub previous_omega: R,
 }
 
 impl FitnessSettings {
@@ -77,25 +80,24 @@ impl FitnessSettings {
     }
 
     /// The points one step earns.
-    pub fn points(&self, e: &StepError) -> f64 {
-        let in_box = e.x.abs() < self.box_half_width && e.y.abs() < self.box_half_width;
-        let on_heading = e.heading.abs() < self.heading_window;
+    #[inline(always)]
+    pub fn points<R: Real>(&self, e: &StepError<R>) -> R {
+        let window = R::splat(self.box_half_width);
+        let in_box = e.x.abs().lt(window) & e.y.abs().lt(window);
+        let on_heading = e.heading.abs().lt(R::splat(self.heading_window));
+        let zero = R::splat(0.0);
         match self.kind {
-            FitnessKind::Original => {
-                if in_box && on_heading {
-                    self.position_points
-                } else {
-                    0.0
-                }
-            }
+            FitnessKind::Original => R::select(in_box & on_heading, R::splat(self.position_points), zero),
             FitnessKind::Incremental => {
                 // [chosen] reading of the paper's "omega_t < omega_t-1": the spin's magnitude falls.
-                let spin_ok = e.omega.abs() < self.spin_window || e.omega.abs() < e.previous_omega.abs();
-                match (in_box && spin_ok, on_heading) {
-                    (true, true) => self.position_points + self.heading_points,
-                    (true, false) => self.position_points,
-                    (false, _) => 0.0,
-                }
+                let spin = e.omega.abs();
+                let spin_ok = spin.lt(R::splat(self.spin_window)) | spin.lt(e.previous_omega.abs());
+                let earned = R::select(
+                    on_heading,
+                    R::splat(self.position_points + self.heading_points),
+                    R::splat(self.position_points),
+                );
+                R::select(in_box & spin_ok, earned, zero)
             }
         }
     }

@@ -2,6 +2,7 @@
 //! thrusters, sensors and noise, the paper's three tasks, both fitness
 //! functions, trials, and the network file format.
 
+pub mod batch;
 pub mod body;
 pub mod fitness;
 pub mod network_file;
@@ -9,6 +10,7 @@ pub mod sensors;
 pub mod task;
 pub mod trial;
 
+pub use batch::BatchRunner;
 pub use body::{BodySettings, THRUSTER_COUNT};
 pub use fitness::{FitnessKind, FitnessSettings};
 pub use network_file::{NetworkFile, NetworkFileError};

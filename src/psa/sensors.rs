@@ -7,6 +7,7 @@ use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 use super::task::Target;
+use crate::numeric::{clamp_unit, Real};
 use crate::physics::{wrap_angle, BodyState};
 
 /// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
@@ -44,14 +45,34 @@ impl SensorSettings {
     /// The network inputs for `state` relative to `target`, without noise:
     /// x, y, vx, vy, heading error wrapped to (-pi, pi], omega, bias.
     pub fn inputs(&self, state: &BodyState, target: &Target) -> [f64; INPUT_COUNT] {
+        let heading_error = wrap_angle(state.heading - target.heading);
+        self.inputs_from(
+            [state.x - target.x, state.y - target.y],
+            [state.vx, state.vy],
+            heading_error,
+            state.omega,
+        )
+    }
+
+    /// The inputs from the position relative to the target, the velocity,
+    /// the wrapped heading error and omega: the arithmetic the scalar and
+    /// the batched paths share.
+    #[inline(always)]
+    pub fn inputs_from<R: Real>(
+        &self,
+        offset: [R; 2],
+        velocity: [R; 2],
+        heading_error: R,
+        omega: R,
+    ) -> [R; INPUT_COUNT] {
         [
-            (state.x - target.x) * self.position_scale,
-            (state.y - target.y) * self.position_scale,
-            state.vx * self.velocity_scale,
-            state.vy * self.velocity_scale,
-            wrap_angle(state.heading - target.heading) * self.heading_scale,
-            state.omega * self.angular_velocity_scale,
-            self.bias,
+            offset[0] * R::splat(self.position_scale),
+            offset[1] * R::splat(self.position_scale),
+            velocity[0] * R::splat(self.velocity_scale),
+            velocity[1] * R::splat(self.velocity_scale),
+            heading_error * R::splat(self.heading_scale),
+            omega * R::splat(self.angular_velocity_scale),
+            R::splat(self.bias),
         ]
     }
 
@@ -110,7 +131,7 @@ impl NoiseSettings {
                 let noise: f64 = StandardNormal.sample(rng);
                 *u += self.output_sd * noise;
             }
-            *u = u.clamp(0.0, 1.0);
+            *u = clamp_unit(*u);
         }
     }
 }

@@ -90,6 +90,18 @@ impl PsaSettings {
         }
         Ok(())
     }
+
+    /// As [`PsaSettings::validate`], and refuses random initialisation for
+    /// task 2, which has no such variant.
+    pub fn validate_for(&self, task: Task) -> Result<(), PsaError> {
+        self.validate()?;
+        if self.random_init && !task.has_random_init() {
+            return Err(PsaError::Setting(format!(
+                "task {task} has no random-initialisation variant"
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// Everything that happened in one trial, for replay and pictures.
@@ -116,12 +128,7 @@ impl TrialRunner {
     /// A runner for `task`; fails on invalid settings or when random
     /// initialisation is asked of task 2, which has no such variant.
     pub fn new(settings: &PsaSettings, task: Task) -> Result<TrialRunner, PsaError> {
-        settings.validate()?;
-        if settings.random_init && !task.has_random_init() {
-            return Err(PsaError::Setting(format!(
-                "task {task} has no random-initialisation variant"
-            )));
-        }
+        settings.validate_for(task)?;
         let model = settings.body.model()?;
         let backend = create_backend(settings.backend, &model, &settings.physics)?;
         Ok(TrialRunner {
@@ -146,7 +153,7 @@ impl TrialRunner {
         self.settings.fitness.maximum(self.settings.steps)
     }
 
-    fn check_network(network: &Network) -> Result<(), PsaError> {
+    pub(crate) fn check_network(network: &Network) -> Result<(), PsaError> {
         if network.inputs() != INPUT_COUNT || network.outputs() != THRUSTER_COUNT {
             return Err(PsaError::Network(format!(
                 "it has {} inputs and {} outputs, the PSA needs {INPUT_COUNT} and {THRUSTER_COUNT}",
@@ -179,26 +186,31 @@ impl TrialRunner {
             r.states.push(start);
         }
         let mut outputs = [0.0; THRUSTER_COUNT];
-        let mut state = self.backend.state();
+        let mut state = self.backend.planar_state();
+        let mut heading_error = wrap_angle(state.heading() - target.heading);
         let mut points = 0.0;
         for _ in 0..s.steps {
-            let mut inputs = s.sensors.inputs(&state, &target);
+            let offset = [state.position[0] - target.x, state.position[1] - target.y];
+            let mut inputs = s
+                .sensors
+                .inputs_from(offset, state.velocity, heading_error, state.omega);
             s.noise.perturb_inputs(&mut inputs, rng);
             network.activate(&inputs, &mut outputs);
             s.noise.perturb_outputs(&mut outputs, rng);
             self.backend.step(&outputs)?;
             let previous_omega = state.omega;
-            state = self.backend.state();
+            state = self.backend.planar_state();
+            heading_error = wrap_angle(state.heading() - target.heading);
             let step_points = s.fitness.points(&StepError {
-                x: state.x - target.x,
-                y: state.y - target.y,
-                heading: wrap_angle(state.heading - target.heading),
+                x: state.position[0] - target.x,
+                y: state.position[1] - target.y,
+                heading: heading_error,
                 omega: state.omega,
                 previous_omega,
             });
             points += step_points;
             if let Some(r) = record.as_deref_mut() {
-                r.states.push(state);
+                r.states.push(state.to_body_state());
                 r.outputs.push(outputs);
                 r.points.push(step_points);
             }
@@ -217,7 +229,12 @@ impl TrialRunner {
     /// The network's fitness: the mean over `trials` trials, in % of the
     /// theoretical maximum.
     pub fn evaluate(&mut self, network: &Network, rng: &mut Stream) -> Result<f64, PsaError> {
-        let trials = self.evaluate_trials(network, rng)?;
-        Ok(trials.iter().sum::<f64>() / trials.len() as f64)
+        Ok(mean_of_trials(&self.evaluate_trials(network, rng)?))
     }
+}
+
+/// An evaluation's fitness from its trials' fitness values: their mean,
+/// summed in trial order.
+pub(crate) fn mean_of_trials(trials: &[f64]) -> f64 {
+    trials.iter().sum::<f64>() / trials.len() as f64
 }

@@ -1,0 +1,225 @@
+//! The elementary functions of the PSA's per-step arithmetic, generic over
+//! [`Real`] so that scalar and batched code share every rounding.
+//!
+//! `exp` and `atan2` are our own polynomial approximations (coefficients
+//! fitted by Chebyshev interpolation in 50-digit arithmetic), accurate to a
+//! few units in the last place: they are the definition of the logistic unit
+//! and the heading for every backend, so that results never depend on the
+//! C library's implementation of these functions.
+
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, LOG2_E, PI, TAU};
+
+use super::Real;
+
+/// 1.5 * 2^52: adding and subtracting it rounds to the nearest integer.
+const ROUNDER: f64 = 6755399441055744.0;
+/// ln 2 split so that k * LN2_HI is exact for |k| < 2^11 (fdlibm's split).
+const LN2_HI: f64 = 6.931_471_803_691_238e-1;
+const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+/// Arguments beyond these give 2^k outside the normal range.
+const EXP_ARGUMENT_LIMIT: f64 = 708.0;
+/// e^r = 1 + r + r^2 q(r) on |r| <= ln2/2: q's coefficients, highest first
+/// (relative error of the fit 1.8e-17).
+const EXP_Q: [f64; 10] = [
+    2.510_037_583_256_123_4e-8,
+    2.762_007_587_998_336_7e-7,
+    2.755_726_848_031_002_4e-6,
+    2.480_152_132_236_869_2e-5,
+    1.984_126_986_304_054_5e-4,
+    1.388_888_891_719_671_9e-3,
+    8.333_333_333_330_065e-3,
+    4.166_666_666_662_416_4e-2,
+    1.666_666_666_666_666_9e-1,
+    5.000_000_000_000_001e-1,
+];
+/// atan(t) = t + t z s(z), z = t^2 <= tan^2(pi/8): s's coefficients, highest
+/// first (error of the fit 5.4e-18).
+const ATAN_S: [f64; 11] = [
+    -1.917_688_711_906_226e-2,
+    3.923_165_829_558_719e-2,
+    -5.085_449_737_940_26e-2,
+    5.858_148_912_802_21e-2,
+    -6.664_511_447_381_948e-2,
+    7.692_183_190_826_087e-2,
+    -9.090_904_578_123_903e-2,
+    1.111_111_101_525_636_1e-1,
+    -1.428_571_428_466_654_2e-1,
+    1.999_999_999_999_552e-1,
+    -3.333_333_333_333_333e-1,
+];
+/// tan(pi/8).
+const TAN_PI_8: f64 = 0.414_213_562_373_095_03;
+
+/// Horner's scheme, highest coefficient first.
+#[inline(always)]
+fn horner<R: Real>(x: R, coefficients: &[f64]) -> R {
+    let mut acc = R::splat(coefficients[0]);
+    for &c in &coefficients[1..] {
+        acc = acc * x + R::splat(c);
+    }
+    acc
+}
+
+/// e^x. Arguments are clamped to [-708, 708] first, so the result is always
+/// finite and positive (e^-708 is about 3e-308).
+#[inline(always)]
+pub fn exp<R: Real>(x: R) -> R {
+    let limit = R::splat(EXP_ARGUMENT_LIMIT);
+    let x = R::select(x.lt(-limit), -limit, x);
+    let x = R::select(limit.lt(x), limit, x);
+    let rounder = R::splat(ROUNDER);
+    let k = (x * R::splat(LOG2_E) + rounder) - rounder;
+    let r = (x - k * R::splat(LN2_HI)) - k * R::splat(LN2_LO);
+    let e_r = R::splat(1.0) + (r + r * r * horner(r, &EXP_Q));
+    e_r * R::exp2_int(k)
+}
+
+/// The logistic function 1 / (1 + e^-x).
+#[inline(always)]
+pub fn sigmoid<R: Real>(x: R) -> R {
+    R::splat(1.0) / (R::splat(1.0) + exp(-x))
+}
+
+/// atan2(y, x) in [-pi, pi], with C's conventions for signed zeros in `y`
+/// (atan2(0, 0) is 0 with the sign of `y`).
+#[inline(always)]
+pub fn atan2<R: Real>(y: R, x: R) -> R {
+    let zero = R::splat(0.0);
+    let (ax, ay) = (x.abs(), y.abs());
+    let steep = ax.lt(ay);
+    let (small, large) = (R::select(steep, ax, ay), R::select(steep, ay, ax));
+    // atan(small/large) in [0, pi/4]; above tan(pi/8), use
+    // atan(t) = pi/4 + atan((t - 1) / (t + 1)).
+    let shifted = (large * R::splat(TAN_PI_8)).lt(small);
+    let numerator = R::select(shifted, small - large, small);
+    let denominator = R::select(shifted, small + large, large);
+    let t = R::select(denominator.le(zero), zero, numerator / denominator);
+    let z = t * t;
+    let base = R::select(shifted, R::splat(FRAC_PI_4), zero);
+    let angle = base + (t + t * z * horner(z, &ATAN_S));
+    let angle = R::select(steep, R::splat(FRAC_PI_2) - angle, angle);
+    let angle = R::select(x.lt(zero), R::splat(PI) - angle, angle);
+    angle.copysign(y)
+}
+
+/// `a % m` (C's `fmod`, exact), for m > 0: exact shortcuts for |a| < 2m
+/// (`|a| - m` is exact there by Sterbenz's lemma), C's `fmod` otherwise.
+#[inline(always)]
+pub fn fmod<R: Real>(a: R, m: f64) -> R {
+    let (abs, modulus) = (a.abs(), R::splat(m));
+    if !R::all(abs.lt(R::splat(2.0 * m))) {
+        return a.rem_slow(m);
+    }
+    R::select(abs.lt(modulus), a, (abs - modulus).copysign(a))
+}
+
+/// An angle wrapped to (-pi, pi].
+#[inline(always)]
+pub fn wrap_angle<R: Real>(angle: R) -> R {
+    let a = fmod(angle, TAU);
+    let a = R::select(R::splat(PI).lt(a), a - R::splat(TAU), a);
+    R::select(a.le(R::splat(-PI)), a + R::splat(TAU), a)
+}
+
+/// `u` clamped to [0, 1] as `f64::clamp` does (NaN stays NaN).
+#[inline(always)]
+pub fn clamp_unit<R: Real>(u: R) -> R {
+    let u = R::select(u.lt(R::splat(0.0)), R::splat(0.0), u);
+    R::select(R::splat(1.0).lt(u), R::splat(1.0), u)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Lanes;
+    use super::*;
+
+    fn ulps(a: f64, b: f64) -> u64 {
+        (a.to_bits() as i64).abs_diff(b.to_bits() as i64)
+    }
+
+    /// Evenly spread and random-looking test points in [lo, hi].
+    fn points(lo: f64, hi: f64, n: usize) -> impl Iterator<Item = f64> {
+        (0..n).map(move |i| lo + (hi - lo) * ((i as f64 * 0.618_033_988_749_894_9) % 1.0))
+    }
+
+    #[test]
+    fn exp_is_within_two_ulps_of_the_c_library() {
+        for x in points(-700.0, 700.0, 200_000).chain(points(-1.0, 1.0, 100_000)) {
+            assert!(ulps(exp(x), x.exp()) <= 2, "exp({x}) = {} vs {}", exp(x), x.exp());
+        }
+        assert_eq!(exp(0.0), 1.0);
+        assert_eq!(exp(-0.0), 1.0);
+        assert_eq!(exp(f64::INFINITY), exp(EXP_ARGUMENT_LIMIT));
+        assert!(exp(-1e6) > 0.0 && exp(1e6).is_finite());
+    }
+
+    #[test]
+    fn sigmoid_saturates_and_is_symmetric() {
+        assert_eq!(sigmoid(0.0), 0.5);
+        assert_eq!(sigmoid(40.0), 1.0);
+        assert!(sigmoid(-40.0) > 0.0 && sigmoid(-40.0) < 1e-17);
+        for x in points(-30.0, 30.0, 10_000) {
+            let exact = 1.0 / (1.0 + (-x).exp());
+            assert!((sigmoid(x) - exact).abs() <= 4.0 * f64::EPSILON * exact, "sigmoid({x})");
+            assert!((sigmoid(x) + sigmoid(-x) - 1.0).abs() <= 2.0 * f64::EPSILON);
+        }
+    }
+
+    #[test]
+    fn atan2_is_within_two_ulps_of_the_c_library_in_every_quadrant() {
+        for (i, angle) in points(-PI, PI, 200_000).enumerate() {
+            let radius = [1.0, 1e-3, 7.5, 1e5][i % 4];
+            let (y, x) = (radius * angle.sin(), radius * angle.cos());
+            assert!(ulps(atan2(y, x), y.atan2(x)) <= 2, "atan2({y}, {x})");
+        }
+        for (y, x) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (0.0, 0.0),
+        ] {
+            assert_eq!(atan2(y, x).to_bits(), y.atan2(x).to_bits(), "atan2({y}, {x})");
+        }
+        assert_eq!(atan2(1.0, 1.0), FRAC_PI_4);
+    }
+
+    #[test]
+    fn fmod_and_wrap_angle_are_exact() {
+        for a in points(-50.0, 50.0, 100_000).chain([TAU, -TAU, 2.0 * TAU, PI, -PI, 0.0, -0.0, 1e300]) {
+            assert_eq!(fmod(a, TAU).to_bits(), (a % TAU).to_bits(), "{a}");
+            let w = wrap_angle(a);
+            assert!(w > -PI && w <= PI, "{a} -> {w}");
+        }
+        assert_eq!(wrap_angle(PI), PI);
+        assert_eq!(wrap_angle(-PI), PI);
+        assert!(wrap_angle(f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn lanes_compute_exactly_what_the_scalar_code_computes() {
+        let xs: Vec<f64> = points(-40.0, 40.0, 4096)
+            .chain([0.0, -0.0, 1e300, -1e300, f64::NAN, f64::INFINITY, PI, -TAU])
+            .collect();
+        for chunk in xs.chunks_exact(8) {
+            let lanes = Lanes::<8>(chunk.try_into().unwrap());
+            let rotated = Lanes::<8>(std::array::from_fn(|i| chunk[(i + 3) % 8]));
+            let results = [
+                (sigmoid(lanes), sigmoid as fn(f64) -> f64),
+                (wrap_angle(lanes), wrap_angle as fn(f64) -> f64),
+                (clamp_unit(lanes), clamp_unit as fn(f64) -> f64),
+            ];
+            for (batched, scalar) in results {
+                for (i, &x) in chunk.iter().enumerate() {
+                    assert_eq!(batched[i].to_bits(), scalar(x).to_bits(), "lane {i} of {chunk:?}");
+                }
+            }
+            let angles = atan2(lanes, rotated);
+            for i in 0..8 {
+                assert_eq!(angles[i].to_bits(), atan2(chunk[i], rotated[i]).to_bits());
+            }
+        }
+    }
+}

@@ -1,0 +1,271 @@
+//! The batched evaluation path: up to [`LANES`] networks fly the PSA in
+//! lockstep, one per SIMD lane, on the `native` backend's physics.
+//!
+//! Weights and states are kept as structures of arrays ([`Lanes`]), and every
+//! step runs the arithmetic the scalar path ([`TrialRunner`] with the
+//! `native` backend) runs, operation for operation: the shared generic
+//! functions of [`crate::numeric`], [`PlanarBody::step`],
+//! [`SensorSettings::inputs_from`](super::SensorSettings::inputs_from) and
+//! [`FitnessSettings::points`](super::FitnessSettings::points), and the
+//! network's summation order (see [`Network::activate`]). So a network's
+//! fitness is bit-identical on both paths and on every [`SimdLevel`]; the
+//! tests hold the paths to that on thousands of random networks.
+//!
+//! Random draws (random starts, input and output noise) stay scalar, lane by
+//! lane, from each network's own stream in the scalar path's order. A lane
+//! whose thrust turns NaN (only possible with absurd weights) is re-run on
+//! the scalar path, which reports the error it raises.
+
+use multiversion::multiversion;
+
+use super::fitness::StepError;
+use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
+use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
+use crate::network::Network;
+use crate::numeric::{clamp_unit, sigmoid, wrap_angle, LaneMask, Lanes, Real, SimdLevel};
+use crate::physics::{BackendKind, PlanarBody, PlanarState};
+use crate::rng::Stream;
+use rand_distr::{Distribution, StandardNormal};
+
+/// Networks evaluated in lockstep by one call of the kernel.
+pub const LANES: usize = 32;
+
+type V = Lanes<LANES>;
+type Mask = LaneMask<LANES>;
+
+/// The weights of a block of networks, lane by lane. Lesioned hidden
+/// neurons, and the missing neurons of networks smaller than the block's
+/// largest, get zero weights: they add exactly +0 to every output.
+struct BlockWeights {
+    hidden: usize,
+    /// Input weights of hidden neuron k: `input[k * INPUT_COUNT..][..INPUT_COUNT]`.
+    input: Vec<V>,
+    /// Output weights of hidden neuron k: `output[k * THRUSTER_COUNT..][..THRUSTER_COUNT]`.
+    output: Vec<V>,
+}
+
+impl BlockWeights {
+    fn new(networks: &[&Network]) -> BlockWeights {
+        let hidden = networks.iter().map(|n| n.hidden()).max().unwrap_or(0);
+        let mut input = vec![V::splat(0.0); hidden * INPUT_COUNT];
+        let mut output = vec![V::splat(0.0); hidden * THRUSTER_COUNT];
+        for (lane, network) in networks.iter().enumerate() {
+            for k in (0..network.hidden()).filter(|&k| !network.is_lesioned(k)) {
+                let (w_in, w_out) = network.neuron(k).split_at(INPUT_COUNT);
+                for (i, &w) in w_in.iter().enumerate() {
+                    input[k * INPUT_COUNT + i][lane] = w;
+                }
+                for (o, &w) in w_out.iter().enumerate() {
+                    output[k * THRUSTER_COUNT + o][lane] = w;
+                }
+            }
+        }
+        BlockWeights { hidden, input, output }
+    }
+}
+
+/// Everything one trial of a block needs.
+struct Flight<'a> {
+    settings: &'a PsaSettings,
+    body: &'a PlanarBody,
+    weights: &'a BlockWeights,
+}
+
+/// Draws `sd * N(0, 1)` onto lane `lane` of each value, in order.
+fn add_noise(values: &mut [V], lane: usize, sd: f64, rng: &mut Stream) {
+    for v in values {
+        let noise: f64 = StandardNormal.sample(rng);
+        v[lane] += sd * noise;
+    }
+}
+
+/// One trial of every lane from `state` towards `target` (x, y, heading);
+/// `rngs[l]` is lane l's stream (lanes beyond `rngs.len()` are padding and
+/// draw nothing). Returns the points and which lanes kept a valid thrust.
+#[inline(always)]
+fn fly(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
+    let s = flight.settings;
+    let weights = flight.weights;
+    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    let mut points = zero;
+    let mut valid = one.le(one);
+    let mut heading_error = wrap_angle(state.heading() - target[2]);
+    for _ in 0..s.steps {
+        let offset = [state.position[0] - target[0], state.position[1] - target[1]];
+        let mut inputs = s
+            .sensors
+            .inputs_from(offset, state.velocity, heading_error, state.omega);
+        if s.noise.input_sd > 0.0 {
+            for (lane, rng) in rngs.iter_mut().enumerate() {
+                add_noise(&mut inputs[..INPUT_COUNT - 1], lane, s.noise.input_sd, rng);
+            }
+        }
+        let mut outputs = [zero; THRUSTER_COUNT];
+        for k in 0..weights.hidden {
+            let w_in = &weights.input[k * INPUT_COUNT..][..INPUT_COUNT];
+            let mut activation = w_in[0] * inputs[0];
+            for i in 1..INPUT_COUNT {
+                activation = activation + w_in[i] * inputs[i];
+            }
+            let h = sigmoid(activation);
+            let w_out = &weights.output[k * THRUSTER_COUNT..][..THRUSTER_COUNT];
+            for (o, &w) in outputs.iter_mut().zip(w_out) {
+                *o = *o + h * w;
+            }
+        }
+        for o in &mut outputs {
+            *o = sigmoid(*o);
+        }
+        if s.noise.output_sd > 0.0 {
+            for (lane, rng) in rngs.iter_mut().enumerate() {
+                add_noise(&mut outputs, lane, s.noise.output_sd, rng);
+            }
+        }
+        for o in &mut outputs {
+            *o = clamp_unit(*o);
+            valid = valid & o.le(one);
+        }
+        let previous_omega = state.omega;
+        flight.body.step(state, &outputs);
+        heading_error = wrap_angle(state.heading() - target[2]);
+        points = points
+            + s.fitness.points(&StepError {
+                x: state.position[0] - target[0],
+                y: state.position[1] - target[1],
+                heading: heading_error,
+                omega: state.omega,
+                previous_omega,
+            });
+    }
+    (points, valid)
+}
+
+#[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))]
+fn fly_avx512(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
+    fly(flight, state, target, rngs)
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn fly_avx2(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
+    fly(flight, state, target, rngs)
+}
+
+fn fly_portable(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
+    fly(flight, state, target, rngs)
+}
+
+/// Evaluates networks on one task in blocks of [`LANES`], on the `native`
+/// backend's physics, with the best [`SimdLevel`] of the CPU.
+#[derive(Debug, Clone)]
+pub struct BatchRunner {
+    settings: PsaSettings,
+    task: Task,
+    body: PlanarBody,
+    level: SimdLevel,
+}
+
+impl BatchRunner {
+    /// A runner for `task`; fails on invalid settings, or when the settings
+    /// name a backend other than `native` (the batched path simulates
+    /// `native`'s physics only).
+    pub fn new(settings: &PsaSettings, task: Task) -> Result<BatchRunner, PsaError> {
+        settings.validate_for(task)?;
+        if settings.backend != BackendKind::Native {
+            return Err(PsaError::Setting(format!(
+                "the batched path runs the native backend only, not {}",
+                settings.backend
+            )));
+        }
+        Ok(BatchRunner {
+            body: PlanarBody::new(&settings.body.model()?, &settings.physics)?,
+            settings: settings.clone(),
+            task,
+            level: SimdLevel::detect(),
+        })
+    }
+
+    /// The same runner on `level` (a level the CPU lacks runs the portable code).
+    pub fn with_level(mut self, level: SimdLevel) -> BatchRunner {
+        self.level = level;
+        self
+    }
+
+    /// The SIMD level in use.
+    pub fn level(&self) -> SimdLevel {
+        self.level
+    }
+
+    /// The fitness of every network, in % of the theoretical maximum, the
+    /// mean over `settings.trials` trials: exactly what
+    /// [`TrialRunner::evaluate`] gives network `i` with stream `rngs[i]`.
+    ///
+    /// # Panics
+    /// If `networks` and `rngs` differ in length.
+    pub fn evaluate(&self, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>, PsaError> {
+        assert_eq!(networks.len(), rngs.len(), "one stream per network");
+        let mut fitness = Vec::with_capacity(networks.len());
+        for (block, streams) in networks.chunks(LANES).zip(rngs.chunks_mut(LANES)) {
+            fitness.extend(self.evaluate_block(block, streams)?);
+        }
+        Ok(fitness)
+    }
+
+    fn evaluate_block(&self, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>, PsaError> {
+        for network in networks {
+            TrialRunner::check_network(network)?;
+        }
+        let s = &self.settings;
+        let saved = rngs.to_vec();
+        let weights = BlockWeights::new(networks);
+        let flight = Flight {
+            settings: s,
+            body: &self.body,
+            weights: &weights,
+        };
+        let maximum = s.fitness.maximum(s.steps);
+        let mut trials = vec![Vec::with_capacity(s.trials); networks.len()];
+        let mut valid = V::splat(0.0).le(V::splat(0.0));
+        for _ in 0..s.trials {
+            let mut starts = [PlanarState::from_body_state(&Default::default()); LANES];
+            let mut targets = [[0.0; 3]; LANES];
+            for (lane, rng) in rngs.iter_mut().enumerate() {
+                let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
+                start.validate()?;
+                starts[lane] = PlanarState::from_body_state(&start);
+                targets[lane] = [target.x, target.y, target.heading];
+            }
+            for lane in networks.len()..LANES {
+                (starts[lane], targets[lane]) = (starts[0], targets[0]);
+            }
+            let lanes = |f: &dyn Fn(usize) -> f64| Lanes(std::array::from_fn(f));
+            let mut state = PlanarState {
+                position: [lanes(&|l| starts[l].position[0]), lanes(&|l| starts[l].position[1])],
+                velocity: [lanes(&|l| starts[l].velocity[0]), lanes(&|l| starts[l].velocity[1])],
+                quaternion: [lanes(&|l| starts[l].quaternion[0]), lanes(&|l| starts[l].quaternion[1])],
+                omega: lanes(&|l| starts[l].omega),
+            };
+            let target = [0, 1, 2].map(|i| lanes(&|l| targets[l][i]));
+            let (points, ok) = match self.level {
+                SimdLevel::Avx512 => fly_avx512(&flight, &mut state, &target, rngs),
+                SimdLevel::Avx2 => fly_avx2(&flight, &mut state, &target, rngs),
+                SimdLevel::Portable => fly_portable(&flight, &mut state, &target, rngs),
+            };
+            valid = valid & ok;
+            for (lane, trial) in trials.iter_mut().enumerate() {
+                trial.push(100.0 * points[lane] / maximum);
+            }
+        }
+        let mut fitness = Vec::with_capacity(networks.len());
+        for (lane, trial) in trials.iter().enumerate() {
+            if valid.0[lane] != 0 {
+                fitness.push(mean_of_trials(trial));
+            } else {
+                // The scalar path, from the lane's original stream, names the problem.
+                let mut rng = saved[lane].clone();
+                fitness.push(TrialRunner::new(s, self.task)?.evaluate(networks[lane], &mut rng)?);
+                rngs[lane] = rng;
+            }
+        }
+        Ok(fitness)
+    }
+}

@@ -1,0 +1,176 @@
+//! The batched (SIMD) evaluation path against the scalar reference: the
+//! same fitness, bit for bit, on thousands of seeded random networks, on
+//! every task, with noise, random starts and several trials, and on every
+//! SIMD level (the portable fallback included).
+
+use psa_esp::network::Network;
+use psa_esp::numeric::SimdLevel;
+use psa_esp::physics::BackendKind;
+use psa_esp::psa::batch::LANES;
+use psa_esp::psa::{BatchRunner, FitnessKind, NoiseSettings, PsaSettings, Task, TrialRunner};
+use psa_esp::rng::{stream, Stream};
+use rand::RngExt;
+
+/// A random 7-H-4 network: H in 1..=9, weights uniform in a range of scale
+/// 0.3 to 30 (from nearly linear to fully saturated units), and now and
+/// then a lesioned neuron.
+fn random_network(seed: u64) -> Network {
+    let mut rng = stream(seed, &[1]);
+    let hidden = rng.random_range(1..=9);
+    let scale = [0.3, 1.0, 3.0, 6.0, 30.0][rng.random_range(0..5)];
+    let genes = (0..hidden * 11).map(|_| rng.random_range(-scale..scale)).collect();
+    let mut network = Network::from_genes(7, 4, genes).unwrap();
+    if hidden > 1 && rng.random_bool(0.2) {
+        network.set_lesioned(rng.random_range(0..hidden), true);
+    }
+    network
+}
+
+fn native(settings: PsaSettings) -> PsaSettings {
+    PsaSettings {
+        backend: BackendKind::Native,
+        ..settings
+    }
+}
+
+fn streams(seeds: std::ops::Range<u64>) -> Vec<Stream> {
+    seeds.map(|s| stream(s, &[2])).collect()
+}
+
+/// Fitness of networks `seeds` by the scalar path and by the batched path on `level`.
+fn both_paths(
+    settings: &PsaSettings,
+    task: Task,
+    seeds: std::ops::Range<u64>,
+    level: SimdLevel,
+) -> (Vec<f64>, Vec<f64>) {
+    let networks: Vec<Network> = seeds.clone().map(random_network).collect();
+    let mut runner = TrialRunner::new(settings, task).unwrap();
+    let scalar = networks
+        .iter()
+        .zip(streams(seeds.clone()))
+        .map(|(n, mut rng)| runner.evaluate(n, &mut rng).unwrap())
+        .collect();
+    let refs: Vec<&Network> = networks.iter().collect();
+    let batched = BatchRunner::new(settings, task)
+        .unwrap()
+        .with_level(level)
+        .evaluate(&refs, &mut streams(seeds))
+        .unwrap();
+    (scalar, batched)
+}
+
+fn assert_bit_identical(scalar: &[f64], batched: &[f64], what: &str) {
+    assert_eq!(scalar.len(), batched.len());
+    let differing: Vec<usize> = (0..scalar.len())
+        .filter(|&i| scalar[i].to_bits() != batched[i].to_bits())
+        .collect();
+    assert!(
+        differing.is_empty(),
+        "{what}: {} of {} networks differ, first {:?}: scalar {} batched {}",
+        differing.len(),
+        scalar.len(),
+        differing.first(),
+        scalar[differing[0]],
+        batched[differing[0]]
+    );
+}
+
+#[test]
+fn batched_fitness_equals_the_scalar_path_on_thousands_of_random_networks() {
+    let settings = native(PsaSettings::default());
+    for task in Task::ALL {
+        let (scalar, batched) = both_paths(&settings, task, 0..1200, SimdLevel::detect());
+        assert_bit_identical(&scalar, &batched, &format!("task {task}"));
+        // The sample is not degenerate: fitness values spread out.
+        let distinct = scalar
+            .iter()
+            .map(|f| f.to_bits())
+            .collect::<std::collections::HashSet<_>>();
+        assert!(
+            distinct.len() >= 30,
+            "task {task}: only {} distinct fitness values",
+            distinct.len()
+        );
+    }
+}
+
+#[test]
+fn batched_fitness_equals_the_scalar_path_with_noise_random_starts_trials_and_the_original_fitness() {
+    let noisy = native(PsaSettings {
+        trials: 3,
+        random_init: true,
+        noise: NoiseSettings {
+            input_sd: 0.05,
+            output_sd: 0.1,
+        },
+        ..PsaSettings::default()
+    });
+    for task in [Task::StopRotation, Task::StopAtPosition] {
+        let (scalar, batched) = both_paths(&noisy, task, 5000..5300, SimdLevel::detect());
+        assert_bit_identical(&scalar, &batched, &format!("noisy task {task}"));
+    }
+    let mut original = native(PsaSettings::default());
+    original.fitness.kind = FitnessKind::Original;
+    original.steps = 300;
+    let (scalar, batched) = both_paths(&original, Task::Turn, 7000..7300, SimdLevel::detect());
+    assert_bit_identical(&scalar, &batched, "original fitness");
+}
+
+#[test]
+fn every_simd_level_computes_the_same_bits_the_portable_fallback_included() {
+    // A level the CPU lacks runs the portable code, so this holds anywhere;
+    // on an AVX-512 machine it compares all three instruction sets.
+    let settings = native(PsaSettings::default());
+    let (scalar, _) = both_paths(&settings, Task::StopAtPosition, 100..400, SimdLevel::Portable);
+    for level in SimdLevel::ALL {
+        let (_, batched) = both_paths(&settings, Task::StopAtPosition, 100..400, level);
+        assert_bit_identical(&scalar, &batched, &format!("level {level}"));
+    }
+}
+
+#[test]
+fn a_partial_block_and_a_single_network_give_the_same_fitness_as_a_full_block() {
+    let settings = native(PsaSettings::default());
+    let runner = BatchRunner::new(&settings, Task::StopRotation).unwrap();
+    let networks: Vec<Network> = (0..LANES as u64 + 3).map(random_network).collect();
+    let refs: Vec<&Network> = networks.iter().collect();
+    let all = runner.evaluate(&refs, &mut streams(0..LANES as u64 + 3)).unwrap();
+    for (i, network) in networks.iter().enumerate() {
+        let alone = runner.evaluate(&[network], &mut [stream(i as u64, &[2])]).unwrap();
+        assert_eq!(alone[0].to_bits(), all[i].to_bits(), "network {i}");
+    }
+}
+
+#[test]
+fn a_network_whose_thrust_turns_nan_gets_the_scalar_paths_error() {
+    let settings = native(PsaSettings::default());
+    // On task 3 the y input is -4 and the heading input pi: weights of
+    // -1e308 on both make +inf and -inf, whose sum is NaN.
+    let mut genes = vec![0.0; 11];
+    genes[1] = -1e308;
+    genes[4] = -1e308;
+    genes[7..11].copy_from_slice(&[1.0; 4]);
+    let bad = Network::from_genes(7, 4, genes).unwrap();
+    let good = random_network(1);
+    let scalar = TrialRunner::new(&settings, Task::StopAtPosition)
+        .unwrap()
+        .evaluate(&bad, &mut stream(0, &[]))
+        .unwrap_err();
+    let batched = BatchRunner::new(&settings, Task::StopAtPosition)
+        .unwrap()
+        .evaluate(&[&good, &bad], &mut [stream(1, &[]), stream(0, &[])])
+        .unwrap_err();
+    assert_eq!(batched.to_string(), scalar.to_string());
+    assert!(scalar.to_string().contains("thrust"), "{scalar}");
+}
+
+#[test]
+fn the_batched_path_refuses_other_backends_and_bad_networks() {
+    let err = BatchRunner::new(&PsaSettings::default(), Task::Turn).unwrap_err();
+    assert!(err.to_string().contains("native"), "{err}");
+    let runner = BatchRunner::new(&native(PsaSettings::default()), Task::Turn).unwrap();
+    let wrong = Network::from_genes(3, 4, vec![0.0; 7]).unwrap();
+    let err = runner.evaluate(&[&wrong], &mut [stream(0, &[])]).unwrap_err();
+    assert!(err.to_string().contains("needs 7"), "{err}");
+}
