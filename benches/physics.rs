@@ -1,4 +1,6 @@
-//! ns per physics step and per PSA network evaluation of each backend (criterion).
+//! ns per physics step of each backend, our ODE path against the bare ODE
+//! calls, and PSA network evaluations on every path: ode, native scalar,
+//! native batched on each SIMD level the CPU has, rapier (criterion).
 //! `psa-esp bench` measures the same in one run and prints a table.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -27,13 +29,49 @@ fn physics_step(c: &mut Criterion) {
     group.finish();
 }
 
-/// One PSA network evaluation (a 500-step trial of task 1) per backend.
+/// 500 steps of our ODE path (`step` + `planar_state`) and of the bare ODE calls.
+fn ode_path(c: &mut Criterion) {
+    use psa_esp::physics::{random_thrust_sequence, OdeBackend, PhysicsBackend};
+    let model = BodySettings::default().model().expect("default body is valid");
+    let thrust = random_thrust_sequence(1, 0, 500, model.thrusters.len());
+    let mut group = c.benchmark_group("ode_path_500_steps");
+    let mut backend = OdeBackend::new(&model, &StepSettings::default()).expect("backend builds");
+    group.bench_function("ours", |b| {
+        b.iter(|| {
+            backend.reset(&BodyState::default()).expect("reset");
+            for row in &thrust {
+                backend.step(row).expect("step");
+                std::hint::black_box(backend.planar_state());
+            }
+        })
+    });
+    let mut reference = OdeBackend::new(&model, &StepSettings::default()).expect("backend builds");
+    group.bench_function("bare", |b| {
+        b.iter(|| {
+            reference.reset(&BodyState::default()).expect("reset");
+            reference
+                .bare_loop(&thrust)
+                .expect("valid thrust")
+                .run(thrust.len(), |s| {
+                    std::hint::black_box(s);
+                })
+        })
+    });
+    group.finish();
+}
+
+/// One PSA network evaluation (a 500-step trial of task 1) per path; the
+/// batched path evaluates 32 networks per iteration, reported per network.
 fn psa_evaluation(c: &mut Criterion) {
     use psa_esp::evolution::operators::random_genes;
     use psa_esp::network::Network;
-    use psa_esp::psa::{PsaSettings, Task, TrialRunner};
+    use psa_esp::numeric::SimdLevel;
+    use psa_esp::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
     let mut rng = psa_esp::rng::stream(1, &[]);
-    let network = Network::from_genes(7, 4, random_genes(&mut rng, 55, 6.0)).expect("valid network");
+    let networks: Vec<Network> = (0..32)
+        .map(|_| Network::from_genes(7, 4, random_genes(&mut rng, 55, 6.0)).expect("valid network"))
+        .collect();
+    let network = &networks[0];
     let mut group = c.benchmark_group("psa_evaluation");
     group.sample_size(20);
     for kind in BackendKind::available() {
@@ -42,16 +80,38 @@ fn psa_evaluation(c: &mut Criterion) {
             ..PsaSettings::default()
         };
         let mut runner = TrialRunner::new(&settings, Task::StopRotation).expect("runner");
-        group.bench_function(kind.name(), |b| {
+        let name = if kind == BackendKind::Native {
+            "native scalar"
+        } else {
+            kind.name()
+        };
+        group.bench_function(name, |b| {
             b.iter(|| {
                 runner
-                    .evaluate(&network, &mut psa_esp::rng::stream(0, &[]))
+                    .evaluate(network, &mut psa_esp::rng::stream(0, &[]))
                     .expect("evaluate")
+            })
+        });
+    }
+    let settings = PsaSettings {
+        backend: BackendKind::Native,
+        ..PsaSettings::default()
+    };
+    let refs: Vec<&Network> = networks.iter().collect();
+    group.throughput(criterion::Throughput::Elements(refs.len() as u64));
+    for level in SimdLevel::ALL.into_iter().filter(|l| l.is_supported()) {
+        let runner = BatchRunner::new(&settings, Task::StopRotation)
+            .expect("runner")
+            .with_level(level);
+        group.bench_function(format!("native batched {level} (32 networks)"), |b| {
+            b.iter(|| {
+                let mut rngs: Vec<_> = (0..refs.len()).map(|_| psa_esp::rng::stream(0, &[])).collect();
+                runner.evaluate(&refs, &mut rngs).expect("evaluate")
             })
         });
     }
     group.finish();
 }
 
-criterion_group!(benches, physics_step, psa_evaluation);
+criterion_group!(benches, physics_step, ode_path, psa_evaluation);
 criterion_main!(benches);

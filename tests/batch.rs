@@ -174,3 +174,41 @@ fn the_batched_path_refuses_other_backends_and_bad_networks() {
     let err = runner.evaluate(&[&wrong], &mut [stream(0, &[])]).unwrap_err();
     assert!(err.to_string().contains("needs 7"), "{err}");
 }
+
+#[test]
+fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
+    use psa_esp::evolution::{Esp, EspSettings};
+    use psa_esp::experiment::PsaEvaluator;
+    let settings = native(PsaSettings::default());
+    let esp = Esp::new(
+        EspSettings {
+            subpop_size: 12,
+            generations: 12,
+            stagnation: 3,
+            ..EspSettings::default()
+        },
+        7,
+    )
+    .unwrap();
+    let run = |level: Option<SimdLevel>, threads: usize| {
+        let evaluator = PsaEvaluator::new(settings.clone(), Task::StopAtPosition)
+            .unwrap()
+            .with_batching(level);
+        let pool = psa_esp::ode::thread_pool(threads).unwrap();
+        let result = pool.install(|| esp.run(&evaluator, |_| {})).unwrap();
+        (
+            result.records,
+            result.champion.network,
+            result.champion.fitness.to_bits(),
+        )
+    };
+    let reference = run(None, 1);
+    assert!(reference.0.iter().any(|r| r.burst), "the run exercises burst mutation");
+    for (level, threads) in [
+        (Some(SimdLevel::detect()), 1),
+        (Some(SimdLevel::detect()), 2),
+        (Some(SimdLevel::Portable), 2),
+    ] {
+        assert_eq!(run(level, threads), reference, "{level:?} on {threads} threads");
+    }
+}

@@ -16,7 +16,7 @@ use crate::evolution::operators::random_genes;
 use crate::experiment::PsaEvaluator;
 use crate::network::Network;
 use crate::numeric::SimdLevel;
-use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, PhysicsBackend};
+use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
 use crate::psa::{BodySettings, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
 
 /// Arguments of `bench`.
@@ -31,7 +31,8 @@ pub struct BenchArgs {
     /// Networks per round of the evaluation benchmark.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..))]
     pub networks: u64,
-    /// Generations of the `evolve` and `replicate` scaling runs.
+    /// Generations of the `evolve` and `replicate` scaling runs (5 times
+    /// as many for the algorithm overhead).
     #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u64).range(2..))]
     pub generations: u64,
     /// Print the results as JSON.
@@ -130,6 +131,15 @@ struct StepTiming {
     relative_to_ode: f64,
 }
 
+/// Our ODE path (`step` and `planar_state` through the backend trait)
+/// against the bare sequence of ODE calls it makes.
+#[derive(Debug, Serialize)]
+struct OdePathTiming {
+    ours_ns_per_step: f64,
+    bare_ns_per_step: f64,
+    overhead_percent: f64,
+}
+
 /// The machine the numbers were measured on.
 #[derive(Debug, Serialize)]
 struct Machine {
@@ -198,6 +208,18 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             relative_to_ode: m / ode,
         })
         .collect();
+    let (ours, bare) = OdeBackend::overhead_sample(
+        &model,
+        &settings,
+        &commands,
+        args.steps as usize,
+        3 * args.rounds as usize,
+    )?;
+    let ode_path = OdePathTiming {
+        ours_ns_per_step: ours.as_nanos() as f64 / args.steps as f64,
+        bare_ns_per_step: bare.as_nanos() as f64 / args.steps as f64,
+        overhead_percent: 100.0 * (ours.as_secs_f64() / bare.as_secs_f64() - 1.0),
+    };
     let networks = random_networks(args.networks)?;
     let steps_per_evaluation = PsaSettings::default().steps as f64;
     let evaluations = EvaluationPath::all()
@@ -217,7 +239,8 @@ pub fn run(args: BenchArgs) -> Result<i32> {
     let generations = args.generations as usize;
     let evolve = evolve_scaling(generations, args.rounds)?;
     let replicate = replicate_scaling(generations, args.rounds)?;
-    let overhead = algorithm_overhead(generations, args.rounds)?;
+    // Long enough that the set-up before the first generation does not count.
+    let overhead = algorithm_overhead(5 * generations, args.rounds)?;
     let machine = machine();
     if args.json {
         let out = serde_json::json!({
@@ -225,6 +248,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             "steps_per_round": args.steps,
             "rounds": args.rounds,
             "physics_step": timings,
+            "ode_path": ode_path,
             "networks_per_round": args.networks,
             "psa_evaluation": evaluations,
             "simd_level_in_use": SimdLevel::detect(),
@@ -256,6 +280,13 @@ pub fn run(args: BenchArgs) -> Result<i32> {
                 t.relative_to_ode
             );
         }
+        say!(
+            "ode path: {:.1} ns/step ours (step + state through the trait) vs {:.1} bare ODE calls: overhead {:.1} % (fastest of {} rounds each)",
+            ode_path.ours_ns_per_step,
+            ode_path.bare_ns_per_step,
+            ode_path.overhead_percent,
+            3 * args.rounds
+        );
         say!(
             "PSA network evaluations (7-5-4 random networks, task 1, {} steps each, {} networks per round, median):",
             steps_per_evaluation,

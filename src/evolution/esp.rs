@@ -266,11 +266,10 @@ impl Esp {
         let networks = picks
             .iter()
             .map(|pick| {
-                let genes: Vec<f64> = pick
-                    .iter()
-                    .zip(&state.subpops)
-                    .flat_map(|(&k, sp)| sp[k].iter().copied())
-                    .collect();
+                let mut genes = Vec::with_capacity(pick.len() * (state.inputs + state.outputs));
+                for (&k, subpop) in pick.iter().zip(&state.subpops) {
+                    genes.extend_from_slice(&subpop[k]);
+                }
                 Network::from_genes(state.inputs, state.outputs, genes)
             })
             .collect::<Result<Vec<_>, _>>()?;

@@ -85,12 +85,16 @@ where
     }
 }
 
-/// Evaluates `networks` in parallel on the current rayon pool, in batches
-/// of the evaluator's [`Evaluator::batch_size`]; network `j` gets the stream
-/// `stream(seed, [key.., j])`. The result is in order and independent of
-/// the thread count and of the batching.
+/// Evaluates `networks` in parallel on the current rayon pool; network `j`
+/// gets the stream `stream(seed, [key.., j])`. A batched evaluator gets
+/// them in one even share per thread (it splits a share into its own
+/// blocks), any other one network at a time. The result is in order and
+/// independent of the thread count and of the batching.
 pub fn evaluate_all<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64, key: &[u64]) -> Result<Vec<f64>> {
-    let batch = evaluator.batch_size().max(1);
+    let batch = match evaluator.batch_size() {
+        0 | 1 => 1,
+        _ => networks.len().div_ceil(rayon::current_num_threads()).max(1),
+    };
     let batches: Vec<Vec<f64>> = networks
         .par_chunks(batch)
         .enumerate()
@@ -101,10 +105,10 @@ pub fn evaluate_all<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64
                     .as_mut()
                     .map_err(|e| anyhow!("cannot set up an evaluation worker: {e}"))?;
                 let first = b * batch;
+                let mut full_key = [key, &[0]].concat();
                 let mut rngs: Vec<Stream> = (first..first + chunk.len())
                     .map(|j| {
-                        let mut full_key = key.to_vec();
-                        full_key.push(j as u64);
+                        *full_key.last_mut().expect("the key has the network index") = j as u64;
                         stream(seed, &full_key)
                     })
                     .collect();

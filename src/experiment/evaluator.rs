@@ -10,6 +10,12 @@ use crate::psa::batch::LANES;
 use crate::psa::{BatchRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use crate::rng::Stream;
 
+/// The environment variable that picks the `native` evaluation path:
+/// `scalar`, or a SIMD level (`portable`, `avx2`, `avx512`) for the batched
+/// path; unset, the best level of the CPU. It changes speed only: every
+/// path gives the same results, bit for bit.
+pub const SIMD_VARIABLE: &str = "PSA_ESP_SIMD";
+
 /// Scores a network by its fitness on a task (in % of the theoretical
 /// maximum, the mean over `settings.trials` trials). Each worker thread
 /// owns one physics world, reused between evaluations. On the `native`
@@ -48,7 +54,16 @@ impl PsaEvaluator {
             BackendKind::Native => Some(BatchRunner::new(&settings, task)?),
             _ => None,
         };
-        Ok(PsaEvaluator { settings, task, batch })
+        let evaluator = PsaEvaluator { settings, task, batch };
+        Ok(match std::env::var(SIMD_VARIABLE) {
+            Err(_) => evaluator,
+            Ok(choice) if choice == "scalar" => evaluator.with_batching(None),
+            Ok(choice) => {
+                evaluator.with_batching(Some(choice.parse().map_err(|e| {
+                    anyhow::anyhow!("{SIMD_VARIABLE}={choice:?}: {e} (or scalar for the scalar path)")
+                })?))
+            }
+        })
     }
 
     /// The same evaluator on `native` with the batched path on `level`, or

@@ -11,6 +11,6 @@ mod run;
 pub mod stats;
 
 pub use config::{Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};
-pub use evaluator::{PsaEvaluator, PsaWorker};
+pub use evaluator::{PsaEvaluator, PsaWorker, SIMD_VARIABLE};
 pub use report::{write_report, ReportFormat, ReportOutcome};
 pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles};

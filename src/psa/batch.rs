@@ -1,5 +1,6 @@
-//! The batched evaluation path: up to [`LANES`] networks fly the PSA in
-//! lockstep, one per SIMD lane, on the `native` backend's physics.
+//! The batched evaluation path: blocks of [`LANES`] networks (and of
+//! [`NARROW_LANES`] for what is left over) fly the PSA in lockstep, one per
+//! SIMD lane, on the `native` backend's physics.
 //!
 //! Weights and states are kept as structures of arrays ([`Lanes`]), and every
 //! step runs the arithmetic the scalar path ([`TrialRunner`] with the
@@ -27,28 +28,29 @@ use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::Stream;
 use rand_distr::{Distribution, StandardNormal};
 
-/// Networks evaluated in lockstep by one call of the kernel.
+/// Networks evaluated in lockstep by one call of the kernel: four AVX-512
+/// registers per value, enough independent work to hide the latency of the
+/// long dependency chain of one step.
 pub const LANES: usize = 32;
-
-type V = Lanes<LANES>;
-type Mask = LaneMask<LANES>;
+/// The kernel's width for the last few networks of a batch.
+pub const NARROW_LANES: usize = 8;
 
 /// The weights of a block of networks, lane by lane. Lesioned hidden
 /// neurons, and the missing neurons of networks smaller than the block's
 /// largest, get zero weights: they add exactly +0 to every output.
-struct BlockWeights {
+struct BlockWeights<const N: usize> {
     hidden: usize,
     /// Input weights of hidden neuron k: `input[k * INPUT_COUNT..][..INPUT_COUNT]`.
-    input: Vec<V>,
+    input: Vec<Lanes<N>>,
     /// Output weights of hidden neuron k: `output[k * THRUSTER_COUNT..][..THRUSTER_COUNT]`.
-    output: Vec<V>,
+    output: Vec<Lanes<N>>,
 }
 
-impl BlockWeights {
-    fn new(networks: &[&Network]) -> BlockWeights {
+impl<const N: usize> BlockWeights<N> {
+    fn new(networks: &[&Network]) -> BlockWeights<N> {
         let hidden = networks.iter().map(|n| n.hidden()).max().unwrap_or(0);
-        let mut input = vec![V::splat(0.0); hidden * INPUT_COUNT];
-        let mut output = vec![V::splat(0.0); hidden * THRUSTER_COUNT];
+        let mut input = vec![Lanes::splat(0.0); hidden * INPUT_COUNT];
+        let mut output = vec![Lanes::splat(0.0); hidden * THRUSTER_COUNT];
         for (lane, network) in networks.iter().enumerate() {
             for k in (0..network.hidden()).filter(|&k| !network.is_lesioned(k)) {
                 let (w_in, w_out) = network.neuron(k).split_at(INPUT_COUNT);
@@ -65,14 +67,14 @@ impl BlockWeights {
 }
 
 /// Everything one trial of a block needs.
-struct Flight<'a> {
+struct Flight<'a, const N: usize> {
     settings: &'a PsaSettings,
     body: &'a PlanarBody,
-    weights: &'a BlockWeights,
+    weights: &'a BlockWeights<N>,
 }
 
 /// Draws `sd * N(0, 1)` onto lane `lane` of each value, in order.
-fn add_noise(values: &mut [V], lane: usize, sd: f64, rng: &mut Stream) {
+fn add_noise<const N: usize>(values: &mut [Lanes<N>], lane: usize, sd: f64, rng: &mut Stream) {
     for v in values {
         let noise: f64 = StandardNormal.sample(rng);
         v[lane] += sd * noise;
@@ -83,10 +85,16 @@ fn add_noise(values: &mut [V], lane: usize, sd: f64, rng: &mut Stream) {
 /// `rngs[l]` is lane l's stream (lanes beyond `rngs.len()` are padding and
 /// draw nothing). Returns the points and which lanes kept a valid thrust.
 #[inline(always)]
-fn fly(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
+fn fly<const N: usize>(
+    flight: &Flight<N>,
+    state: &mut PlanarState<Lanes<N>>,
+    target: &[Lanes<N>; 3],
+    rngs: &mut [Stream],
+) -> (Lanes<N>, LaneMask<N>) {
+    type V<const N: usize> = Lanes<N>;
     let s = flight.settings;
     let weights = flight.weights;
-    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    let (zero, one) = (V::<N>::splat(0.0), V::<N>::splat(1.0));
     let mut points = zero;
     let mut valid = one.le(one);
     let mut heading_error = wrap_angle(state.heading() - target[2]);
@@ -140,19 +148,58 @@ fn fly(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut 
     (points, valid)
 }
 
-#[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))]
-fn fly_avx512(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
-    fly(flight, state, target, rngs)
+/// The kernel of width `$n` as a function with the attributes given (a
+/// `multiversion` target list, or none for the portable build).
+macro_rules! kernel {
+    ($(#[$attr:meta])* $name:ident, $n:expr) => {
+        $(#[$attr])*
+        fn $name(
+            flight: &Flight<$n>,
+            state: &mut PlanarState<Lanes<$n>>,
+            target: &[Lanes<$n>; 3],
+            rngs: &mut [Stream],
+        ) -> (Lanes<$n>, LaneMask<$n>) {
+            fly(flight, state, target, rngs)
+        }
+    };
 }
 
-#[multiversion(targets("x86_64+avx2"))]
-fn fly_avx2(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
-    fly(flight, state, target, rngs)
+/// The kernel of width `$n` compiled for each [`SimdLevel`], and a
+/// function that runs the one asked for.
+macro_rules! kernels {
+    ($run:ident, $avx512:ident, $avx2:ident, $portable:ident, $n:expr) => {
+        kernel!(#[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))] $avx512, $n);
+        kernel!(#[multiversion(targets("x86_64+avx2"))] $avx2, $n);
+        kernel!($portable, $n);
+
+        fn $run(
+            level: SimdLevel,
+            flight: &Flight<$n>,
+            state: &mut PlanarState<Lanes<$n>>,
+            target: &[Lanes<$n>; 3],
+            rngs: &mut [Stream],
+        ) -> (Lanes<$n>, LaneMask<$n>) {
+            match level {
+                SimdLevel::Avx512 => $avx512(flight, state, target, rngs),
+                SimdLevel::Avx2 => $avx2(flight, state, target, rngs),
+                SimdLevel::Portable => $portable(flight, state, target, rngs),
+            }
+        }
+    };
 }
 
-fn fly_portable(flight: &Flight, state: &mut PlanarState<V>, target: &[V; 3], rngs: &mut [Stream]) -> (V, Mask) {
-    fly(flight, state, target, rngs)
-}
+kernels!(fly_wide, fly_wide_avx512, fly_wide_avx2, fly_wide_portable, LANES);
+kernels!(
+    fly_narrow,
+    fly_narrow_avx512,
+    fly_narrow_avx2,
+    fly_narrow_portable,
+    NARROW_LANES
+);
+
+/// A kernel of width N run on a [`SimdLevel`].
+type Kernel<const N: usize> =
+    fn(SimdLevel, &Flight<N>, &mut PlanarState<Lanes<N>>, &[Lanes<N>; 3], &mut [Stream]) -> (Lanes<N>, LaneMask<N>);
 
 /// Evaluates networks on one task in blocks of [`LANES`], on the `native`
 /// backend's physics, with the best [`SimdLevel`] of the CPU.
@@ -204,37 +251,57 @@ impl BatchRunner {
     pub fn evaluate(&self, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>, PsaError> {
         assert_eq!(networks.len(), rngs.len(), "one stream per network");
         let mut fitness = Vec::with_capacity(networks.len());
-        for (block, streams) in networks.chunks(LANES).zip(rngs.chunks_mut(LANES)) {
-            fitness.extend(self.evaluate_block(block, streams)?);
+        let mut start = 0;
+        while start < networks.len() {
+            let left = networks.len() - start;
+            // Full wide blocks; a remainder of up to 16 goes in narrow blocks.
+            let width = if left > 2 * NARROW_LANES { LANES } else { NARROW_LANES };
+            let end = start + left.min(width);
+            let (block, streams) = (&networks[start..end], &mut rngs[start..end]);
+            if width == LANES {
+                self.evaluate_block::<LANES>(fly_wide, block, streams, &mut fitness)?;
+            } else {
+                self.evaluate_block::<NARROW_LANES>(fly_narrow, block, streams, &mut fitness)?;
+            }
+            start = end;
         }
         Ok(fitness)
     }
 
-    fn evaluate_block(&self, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>, PsaError> {
+    /// Evaluates up to N networks with the kernel `fly`, appending their fitness.
+    fn evaluate_block<const N: usize>(
+        &self,
+        fly: Kernel<N>,
+        networks: &[&Network],
+        rngs: &mut [Stream],
+        fitness: &mut Vec<f64>,
+    ) -> Result<(), PsaError> {
         for network in networks {
             TrialRunner::check_network(network)?;
         }
         let s = &self.settings;
-        let saved = rngs.to_vec();
-        let weights = BlockWeights::new(networks);
+        // Where each stream stood, for a lane that must be re-run.
+        let positions: Vec<u128> = rngs.iter().map(|r| r.get_word_pos()).collect();
+        let weights = BlockWeights::<N>::new(networks);
         let flight = Flight {
             settings: s,
             body: &self.body,
             weights: &weights,
         };
         let maximum = s.fitness.maximum(s.steps);
-        let mut trials = vec![Vec::with_capacity(s.trials); networks.len()];
-        let mut valid = V::splat(0.0).le(V::splat(0.0));
-        for _ in 0..s.trials {
-            let mut starts = [PlanarState::from_body_state(&Default::default()); LANES];
-            let mut targets = [[0.0; 3]; LANES];
+        // trials[lane * s.trials + t]: lane's fitness in trial t.
+        let mut trials = vec![0.0; networks.len() * s.trials];
+        let mut valid = Lanes::<N>::splat(0.0).le(Lanes::splat(0.0));
+        for t in 0..s.trials {
+            let mut starts = [PlanarState::from_body_state(&Default::default()); N];
+            let mut targets = [[0.0; 3]; N];
             for (lane, rng) in rngs.iter_mut().enumerate() {
                 let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
                 start.validate()?;
                 starts[lane] = PlanarState::from_body_state(&start);
                 targets[lane] = [target.x, target.y, target.heading];
             }
-            for lane in networks.len()..LANES {
+            for lane in networks.len()..N {
                 (starts[lane], targets[lane]) = (starts[0], targets[0]);
             }
             let lanes = |f: &dyn Fn(usize) -> f64| Lanes(std::array::from_fn(f));
@@ -245,27 +312,21 @@ impl BatchRunner {
                 omega: lanes(&|l| starts[l].omega),
             };
             let target = [0, 1, 2].map(|i| lanes(&|l| targets[l][i]));
-            let (points, ok) = match self.level {
-                SimdLevel::Avx512 => fly_avx512(&flight, &mut state, &target, rngs),
-                SimdLevel::Avx2 => fly_avx2(&flight, &mut state, &target, rngs),
-                SimdLevel::Portable => fly_portable(&flight, &mut state, &target, rngs),
-            };
+            let (points, ok) = fly(self.level, &flight, &mut state, &target, rngs);
             valid = valid & ok;
-            for (lane, trial) in trials.iter_mut().enumerate() {
-                trial.push(100.0 * points[lane] / maximum);
+            for lane in 0..networks.len() {
+                trials[lane * s.trials + t] = 100.0 * points[lane] / maximum;
             }
         }
-        let mut fitness = Vec::with_capacity(networks.len());
-        for (lane, trial) in trials.iter().enumerate() {
+        for (lane, trial) in trials.chunks_exact(s.trials).enumerate() {
             if valid.0[lane] != 0 {
                 fitness.push(mean_of_trials(trial));
             } else {
                 // The scalar path, from the lane's original stream, names the problem.
-                let mut rng = saved[lane].clone();
-                fitness.push(TrialRunner::new(s, self.task)?.evaluate(networks[lane], &mut rng)?);
-                rngs[lane] = rng;
+                rngs[lane].set_word_pos(positions[lane]);
+                fitness.push(TrialRunner::new(s, self.task)?.evaluate(networks[lane], &mut rngs[lane])?);
             }
         }
-        Ok(fitness)
+        Ok(())
     }
 }
