@@ -122,6 +122,32 @@ impl Network {
         &self.genes[k * per..(k + 1) * per]
     }
 
+    /// Overwrites the genes of hidden neuron `k` (input weights, then output
+    /// weights); its lesion flag is cleared. Fails on a wrong length or a
+    /// non-finite weight, leaving the network unchanged.
+    ///
+    /// # Panics
+    /// If `k` is not a hidden neuron.
+    pub fn set_neuron(&mut self, k: usize, genes: &[f64]) -> Result<(), NetworkError> {
+        let per = self.genes_per_neuron();
+        if genes.len() != per {
+            return Err(NetworkError::Shape(format!(
+                "hidden neuron {k} needs {per} weights, got {}",
+                genes.len()
+            )));
+        }
+        if let Some((index, &value)) = genes.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(NetworkError::NonFinite {
+                neuron: k,
+                index,
+                value,
+            });
+        }
+        self.genes[k * per..(k + 1) * per].copy_from_slice(genes);
+        self.lesioned[k] = false;
+        Ok(())
+    }
+
     /// Switches hidden neuron `k` off (`true`) or on.
     pub fn set_lesioned(&mut self, k: usize, lesioned: bool) {
         self.lesioned[k] = lesioned;
@@ -191,6 +217,18 @@ mod tests {
         let mut out2 = [0.0];
         alone.activate(&[2.0, 1.0], &mut out2);
         assert_eq!(out, out2);
+    }
+
+    #[test]
+    fn set_neuron_overwrites_one_neuron_and_refuses_bad_genes() {
+        let mut net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
+        net.set_lesioned(1, true);
+        net.set_neuron(1, &[4.0, 5.0, 6.0]).unwrap();
+        assert_eq!(net.genes(), &[1.0, -1.0, 2.0, 4.0, 5.0, 6.0]);
+        assert!(!net.is_lesioned(1));
+        assert!(net.set_neuron(0, &[1.0, 2.0]).is_err());
+        assert!(net.set_neuron(0, &[1.0, f64::NAN, 2.0]).is_err());
+        assert_eq!(net.neuron(0), &[1.0, -1.0, 2.0]);
     }
 
     #[test]

@@ -167,6 +167,9 @@ struct State {
     pending: Option<LesionOutcome>,
     bursts: usize,
     evaluations: u64,
+    /// The networks of the last generation, reused so that a generation
+    /// allocates no network (their genes are overwritten).
+    networks: Vec<Network>,
 }
 
 impl State {
@@ -183,7 +186,29 @@ impl State {
             pending: None,
             bursts: 0,
             evaluations: 0,
+            networks: Vec::new(),
         }
+    }
+
+    /// The networks `picks` assemble (pick[i]: the neuron taken from
+    /// sub-population i), written over the last generation's networks.
+    fn assemble(&mut self, picks: &[Vec<usize>]) -> Result<&[Network]> {
+        let hidden = self.subpops.len();
+        let reusable = self.networks.first().is_some_and(|n| n.hidden() == hidden);
+        if !reusable || self.networks.len() != picks.len() {
+            let blank = Network::from_genes(
+                self.inputs,
+                self.outputs,
+                vec![0.0; hidden * (self.inputs + self.outputs)],
+            )?;
+            self.networks = vec![blank; picks.len()];
+        }
+        for (network, pick) in self.networks.iter_mut().zip(picks) {
+            for (i, (&k, subpop)) in pick.iter().zip(&self.subpops).enumerate() {
+                network.set_neuron(i, &subpop[k])?;
+            }
+        }
+        Ok(&self.networks)
     }
 }
 
@@ -261,33 +286,37 @@ impl Esp {
         state: &mut State,
         generation: usize,
     ) -> Result<GenerationRecord> {
-        let s = &self.settings;
         let picks = self.sample(generation, state.subpops.len());
-        let networks = picks
-            .iter()
-            .map(|pick| {
-                let mut genes = Vec::with_capacity(pick.len() * (state.inputs + state.outputs));
-                for (&k, subpop) in pick.iter().zip(&state.subpops) {
-                    genes.extend_from_slice(&subpop[k]);
-                }
-                Network::from_genes(state.inputs, state.outputs, genes)
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let fitness = evaluate_all(evaluator, &networks, self.seed, &[purpose::EVALUATE, generation as u64])?;
-        state.evaluations += networks.len() as u64;
+        let networks = state.assemble(&picks)?;
+        let fitness = evaluate_all(evaluator, networks, self.seed, &[purpose::EVALUATE, generation as u64])?;
+        self.conclude(evaluator, state, &picks, fitness, generation)
+    }
+
+    /// The generation after its evaluation: champion and best, then burst
+    /// mutation or credit and recombination; returns its record.
+    fn conclude<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        picks: &[Vec<usize>],
+        fitness: Vec<f64>,
+        generation: usize,
+    ) -> Result<GenerationRecord> {
+        let s = &self.settings;
+        state.evaluations += picks.len() as u64;
 
         // The generation's best network updates the champion and the search's best.
         let (top, top_fitness) = best_of(&fitness);
         if state.champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
             state.champion = Some(Champion {
-                network: networks[top].clone(),
+                network: state.networks[top].clone(),
                 fitness: top_fitness,
                 generation,
             });
         }
         let improved = state.best.as_ref().is_none_or(|(_, f)| top_fitness > *f);
         if improved {
-            state.best = Some((networks[top].clone(), top_fitness));
+            state.best = Some((state.networks[top].clone(), top_fitness));
             state.since_improvement = 0;
             state.bursts_since_improvement = 0;
             state.pending = None;
@@ -302,7 +331,7 @@ impl Esp {
             burst = true;
             lesion = self.stagnate(evaluator, state, generation)?;
         } else {
-            self.assign_credit(state, &picks, &fitness);
+            self.assign_credit(state, picks, &fitness);
             for (i, subpop) in state.subpops.iter_mut().enumerate() {
                 self.recombine(subpop, generation, i);
             }

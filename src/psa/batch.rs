@@ -168,8 +168,16 @@ macro_rules! kernel {
 /// function that runs the one asked for.
 macro_rules! kernels {
     ($run:ident, $avx512:ident, $avx2:ident, $portable:ident, $n:expr) => {
-        kernel!(#[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))] $avx512, $n);
-        kernel!(#[multiversion(targets("x86_64+avx2"))] $avx2, $n);
+        kernel!(
+            #[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))]
+            $avx512,
+            $n
+        );
+        kernel!(
+            #[multiversion(targets("x86_64+avx2"))]
+            $avx2,
+            $n
+        );
         kernel!($portable, $n);
 
         fn $run(
