@@ -348,15 +348,4 @@ mod tests {
         let bad = vec![vec![2.0; 4]];
         assert!(OdeBackend::overhead_sample(&model, &StepSettings::default(), &bad, 10, 1).is_err());
     }
-
-    /// The measured overhead (issue 6): `cargo test --release --lib ode_overhead -- --ignored --nocapture`.
-    #[test]
-    #[ignore = "timing, run by hand"]
-    fn ode_overhead() {
-        let model = model();
-        let thrust = random_thrust_sequence(1, 0, 500, model.thrusters.len());
-        let (ours, bare) = OdeBackend::overhead_sample(&model, &StepSettings::default(), &thrust, 20_000, 15).unwrap();
-        let percent = 100.0 * (ours.as_secs_f64() / bare.as_secs_f64() - 1.0);
-        println!("ours {ours:?}, bare {bare:?} per 20000 steps: overhead {percent:.1} %");
-    }
 }
