@@ -16,7 +16,7 @@ use crate::psa::Task;
 #[derive(Debug, clap::Args)]
 pub struct ReplicateArgs {
     /// quick: a reduced grid (5 seeds, 80 generations, 100-trial robustness,
-    /// native backend; about 5 minutes on 2 cores); paper: the full protocol
+    /// native backend; about a minute on 2 cores); paper: the full protocol
     /// (30 seeds, 2000 generations, 500-trial robustness, ode backend).
     #[arg(long, value_enum, default_value_t = GridPreset::Quick)]
     pub preset: GridPreset,

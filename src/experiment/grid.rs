@@ -29,7 +29,7 @@ pub const GRID_VERSION: u32 = 1;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum GridPreset {
-    /// A reduced grid that finishes in about 5 minutes on 2 cores.
+    /// A reduced grid that finishes in about a minute on 2 cores.
     Quick,
     /// The paper's full protocol: 2000 generations, 30 seeds, 500-trial robustness tests.
     Paper,
