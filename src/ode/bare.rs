@@ -39,6 +39,21 @@ pub struct RawBodyState {
     pub angular_velocity: [f64; 3],
 }
 
+impl RawBodyState {
+    /// The values a planar state is built from: x, y, qw, qz, vx, vy, omega.
+    pub fn planar_values(&self) -> [f64; 7] {
+        [
+            self.position[0],
+            self.position[1],
+            self.quaternion[0],
+            self.quaternion[3],
+            self.linear_velocity[0],
+            self.linear_velocity[1],
+            self.angular_velocity[2],
+        ]
+    }
+}
+
 /// A validated thrust sequence driving one existing body with raw ODE calls
 /// (see the module documentation). Borrows the body, so the body and its
 /// world outlive it.
