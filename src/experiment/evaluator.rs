@@ -113,14 +113,11 @@ impl Evaluator for PsaEvaluator {
     fn evaluate_batch(&self, worker: &mut PsaWorker, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>> {
         match &worker.batch {
             Some(batch) => Ok(batch.evaluate(networks, rngs)?),
-            None => {
-                let scalar = self.scalar(worker)?;
-                networks
-                    .iter()
-                    .zip(rngs)
-                    .map(|(network, rng)| Ok(scalar.evaluate(network, rng)?))
-                    .collect()
-            }
+            None => networks
+                .iter()
+                .zip(rngs)
+                .map(|(network, rng)| self.evaluate(worker, network, rng))
+                .collect(),
         }
     }
 }

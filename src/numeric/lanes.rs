@@ -41,15 +41,10 @@ impl<const N: usize> Lanes<N> {
         Lanes(from_fn(|i| f64::from_bits(bits[i])))
     }
 
-    /// Lane `i`'s value applied through `f`, lane by lane.
+    /// `f` applied to the two operands lane by lane.
     #[inline(always)]
     fn map2(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self {
         Lanes(from_fn(|i| f(self.0[i], other.0[i])))
-    }
-
-    /// Whether any lane is NaN.
-    pub fn any_nan(self) -> bool {
-        self.0.iter().any(|v| v.is_nan())
     }
 }
 
