@@ -161,12 +161,14 @@ impl Network {
     /// Computes the outputs for `input` into `output`; allocates nothing.
     ///
     /// The order of operations is part of the definition (the batched path
-    /// in `psa::batch` repeats it lane by lane): each hidden unit sums
-    /// `w[0] x[0] + w[1] x[1] + ...` from the left; each output starts at 0
-    /// and adds the hidden units' contributions in neuron order.
+    /// in `psa::batch` repeats it lane by lane): each hidden unit starts at
+    /// `w[0] x[0]` and adds `w[1] x[1]`, `w[2] x[2]`, ... one fused
+    /// multiply-add at a time; each output starts at 0 and adds the hidden
+    /// units' contributions in neuron order, also fused.
     ///
     /// # Panics
     /// If the slices' lengths differ from the network's inputs and outputs.
+    #[inline(always)]
     pub fn activate(&self, input: &[f64], output: &mut [f64]) {
         assert_eq!(input.len(), self.inputs, "input length");
         assert_eq!(output.len(), self.outputs, "output length");
@@ -179,11 +181,11 @@ impl Network {
             let (w_in, w_out) = neuron.split_at(self.inputs);
             let mut activation = w_in[0] * input[0];
             for (w, x) in w_in.iter().zip(input).skip(1) {
-                activation += w * x;
+                activation = w.mul_add(*x, activation);
             }
             let h = sigmoid(activation);
             for (o, w) in output.iter_mut().zip(w_out) {
-                *o += h * w;
+                *o = h.mul_add(*w, *o);
             }
         }
         for o in output.iter_mut() {
@@ -202,7 +204,9 @@ mod tests {
         let net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
         let mut out = [0.0];
         net.activate(&[2.0, 1.0], &mut out);
-        let expected = sigmoid(2.0 * sigmoid(1.0) - 3.0 * sigmoid(1.0));
+        // Each output adds its hidden units' contributions with fused multiply-adds.
+        let h = sigmoid(1.0);
+        let expected = sigmoid(h.mul_add(-3.0, 2.0 * h));
         assert_eq!(out[0], expected);
     }
 

@@ -144,12 +144,12 @@ fn a_partial_block_and_a_single_network_give_the_same_fitness_as_a_full_block() 
 
 #[test]
 fn a_network_whose_thrust_turns_nan_gets_the_scalar_paths_error() {
-    let settings = native(PsaSettings::default());
-    // On task 3 the y input is -4 and the heading input pi: weights of
-    // -1e308 on both make +inf and -inf, whose sum is NaN.
+    // Finite weights cannot make NaN (every sum is a fused multiply-add),
+    // but an absurd input scale can: on task 3 the y input becomes -inf,
+    // and its weight of 0 times -inf is NaN.
+    let mut settings = native(PsaSettings::default());
+    settings.sensors.position_scale = 1e308;
     let mut genes = vec![0.0; 11];
-    genes[1] = -1e308;
-    genes[4] = -1e308;
     genes[7..11].copy_from_slice(&[1.0; 4]);
     let bad = Network::from_genes(7, 4, genes).unwrap();
     let good = random_network(1);

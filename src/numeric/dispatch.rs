@@ -10,9 +10,10 @@ use std::str::FromStr;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SimdLevel {
-    /// The target's baseline (SSE2 on x86-64): runs on any CPU.
+    /// The target's baseline (SSE2 on x86-64): runs on any CPU, slowly,
+    /// as every fused multiply-add is a function call.
     Portable,
-    /// AVX2 (x86-64-v3): 4 lanes per register.
+    /// AVX2 and FMA (x86-64-v3): 4 lanes per register.
     Avx2,
     /// AVX-512 F/DQ (x86-64-v4): 8 lanes per register.
     Avx512,
@@ -36,7 +37,9 @@ impl SimdLevel {
         match self {
             SimdLevel::Portable => true,
             #[cfg(target_arch = "x86_64")]
-            SimdLevel::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            SimdLevel::Avx2 => {
+                std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+            }
             #[cfg(target_arch = "x86_64")]
             SimdLevel::Avx512 => {
                 std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512dq")

@@ -138,6 +138,10 @@ impl<const N: usize> Real for Lanes<N> {
         Lanes(from_fn(|i| self.0[i].sqrt()))
     }
     #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        Lanes(from_fn(|i| self.0[i].mul_add(a.0[i], b.0[i])))
+    }
+    #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
         let (m, s) = (self.bits(), sign.bits());
         Self::from_bits(from_fn(|i| (m[i] & !SIGN_BIT) | (s[i] & SIGN_BIT)))

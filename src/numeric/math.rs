@@ -55,7 +55,7 @@ const TAN_PI_8: f64 = 0.414_213_562_373_095_03;
 fn horner<R: Real>(x: R, coefficients: &[f64]) -> R {
     let mut acc = R::splat(coefficients[0]);
     for &c in &coefficients[1..] {
-        acc = acc * x + R::splat(c);
+        acc = acc.mul_add(x, R::splat(c));
     }
     acc
 }
@@ -68,9 +68,9 @@ pub fn exp<R: Real>(x: R) -> R {
     let x = R::select(x.lt(-limit), -limit, x);
     let x = R::select(limit.lt(x), limit, x);
     let rounder = R::splat(ROUNDER);
-    let k = (x * R::splat(LOG2_E) + rounder) - rounder;
-    let r = (x - k * R::splat(LN2_HI)) - k * R::splat(LN2_LO);
-    let e_r = R::splat(1.0) + (r + r * r * horner(r, &EXP_Q));
+    let k = x.mul_add(R::splat(LOG2_E), rounder) - rounder;
+    let r = k.mul_add(R::splat(-LN2_LO), k.mul_add(R::splat(-LN2_HI), x));
+    let e_r = R::splat(1.0) + (r * r).mul_add(horner(r, &EXP_Q), r);
     e_r * R::exp2_int(k)
 }
 
@@ -96,7 +96,7 @@ pub fn atan2<R: Real>(y: R, x: R) -> R {
     let t = R::select(denominator.le(zero), zero, numerator / denominator);
     let z = t * t;
     let base = R::select(shifted, R::splat(FRAC_PI_4), zero);
-    let angle = base + (t + t * z * horner(z, &ATAN_S));
+    let angle = base + (t * z).mul_add(horner(z, &ATAN_S), t);
     let angle = R::select(steep, R::splat(FRAC_PI_2) - angle, angle);
     let angle = R::select(x.lt(zero), R::splat(PI) - angle, angle);
     angle.copysign(y)

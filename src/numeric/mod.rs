@@ -5,10 +5,15 @@
 //! written once, generic over [`Real`]: a plain `f64` for the scalar path and
 //! [`Lanes`] (one value per network evaluated in lockstep) for the batched
 //! path. Both instantiate the very same sequence of IEEE-754 operations
-//! (additions, multiplications, divisions, square roots, comparisons; never a
-//! fused multiply-add, never a library call whose result could differ), so
-//! the two paths give bit-identical results on every CPU, whatever SIMD width
-//! [`SimdLevel`] picks at run time.
+//! (additions, multiplications, fused multiply-adds where the code says
+//! [`Real::mul_add`], divisions, square roots, comparisons; never a library
+//! call whose result could differ), so the two paths give bit-identical
+//! results on every CPU, whatever SIMD width [`SimdLevel`] picks at run
+//! time. A fused multiply-add rounds once, exactly as IEEE-754 defines it,
+//! whether the CPU has the instruction or Rust's `f64::mul_add` computes it
+//! in software; the compiler never fuses a multiplication and an addition
+//! on its own, so the rigid-body update, which must match ODE's unfused
+//! arithmetic, stays unfused.
 
 mod dispatch;
 mod lanes;
@@ -32,6 +37,8 @@ pub trait Real:
     fn abs(self) -> Self;
     /// Correctly rounded square root.
     fn sqrt(self) -> Self;
+    /// `self * a + b` with one rounding (fused multiply-add).
+    fn mul_add(self, a: Self, b: Self) -> Self;
     /// The magnitude of `self` with the sign bit of `sign`.
     fn copysign(self, sign: Self) -> Self;
     /// `self < other` (false when either is NaN).
@@ -61,6 +68,10 @@ impl Real for f64 {
     #[inline(always)]
     fn sqrt(self) -> f64 {
         f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn mul_add(self, a: f64, b: f64) -> f64 {
+        f64::mul_add(self, a, b)
     }
     #[inline(always)]
     fn copysign(self, sign: f64) -> f64 {

@@ -14,8 +14,9 @@
 //!
 //! Random draws (random starts, input and output noise) stay scalar, lane by
 //! lane, from each network's own stream in the scalar path's order. A lane
-//! whose thrust turns NaN (only possible with absurd weights) is re-run on
-//! the scalar path, which reports the error it raises.
+//! whose thrust turns NaN (only possible with absurd settings, such as an
+//! input scale that overflows) is re-run on the scalar path, which reports
+//! the error it raises.
 
 use multiversion::multiversion;
 
@@ -113,12 +114,12 @@ fn fly<const N: usize>(
             let w_in = &weights.input[k * INPUT_COUNT..][..INPUT_COUNT];
             let mut activation = w_in[0] * inputs[0];
             for i in 1..INPUT_COUNT {
-                activation = activation + w_in[i] * inputs[i];
+                activation = w_in[i].mul_add(inputs[i], activation);
             }
             let h = sigmoid(activation);
             let w_out = &weights.output[k * THRUSTER_COUNT..][..THRUSTER_COUNT];
             for (o, &w) in outputs.iter_mut().zip(w_out) {
-                *o = *o + h * w;
+                *o = h.mul_add(w, *o);
             }
         }
         for o in &mut outputs {
@@ -174,7 +175,7 @@ macro_rules! kernels {
             $n
         );
         kernel!(
-            #[multiversion(targets("x86_64+avx2"))]
+            #[multiversion(targets("x86_64+avx2+fma"))]
             $avx2,
             $n
         );

@@ -1,6 +1,7 @@
 //! One trial of the control problem: a network flies the PSA for a fixed
 //! number of steps and earns fitness points step by step.
 
+use multiversion::multiversion;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -185,37 +186,7 @@ impl TrialRunner {
             };
             r.states.push(start);
         }
-        let mut outputs = [0.0; THRUSTER_COUNT];
-        let mut state = self.backend.planar_state();
-        let mut heading_error = wrap_angle(state.heading() - target.heading);
-        let mut points = 0.0;
-        for _ in 0..s.steps {
-            let offset = [state.position[0] - target.x, state.position[1] - target.y];
-            let mut inputs = s
-                .sensors
-                .inputs_from(offset, state.velocity, heading_error, state.omega);
-            s.noise.perturb_inputs(&mut inputs, rng);
-            network.activate(&inputs, &mut outputs);
-            s.noise.perturb_outputs(&mut outputs, rng);
-            self.backend.step(&outputs)?;
-            let previous_omega = state.omega;
-            state = self.backend.planar_state();
-            heading_error = wrap_angle(state.heading() - target.heading);
-            let step_points = s.fitness.points(&StepError {
-                x: state.position[0] - target.x,
-                y: state.position[1] - target.y,
-                heading: heading_error,
-                omega: state.omega,
-                previous_omega,
-            });
-            points += step_points;
-            if let Some(r) = record.as_deref_mut() {
-                r.states.push(state.to_body_state());
-                r.outputs.push(outputs);
-                r.points.push(step_points);
-            }
-        }
-        Ok(points)
+        fly(s, self.backend.as_mut(), network, &target, rng, record)
     }
 
     /// The fitness of every trial, in % of the theoretical maximum.
@@ -231,6 +202,55 @@ impl TrialRunner {
     pub fn evaluate(&mut self, network: &Network, rng: &mut Stream) -> Result<f64, PsaError> {
         Ok(mean_of_trials(&self.evaluate_trials(network, rng)?))
     }
+}
+
+/// The steps of one trial from the backend's current state; returns the
+/// points and fills `record` (already holding the start) when given.
+///
+/// Compiled twice, and picked at run time: with AVX2 and FMA instructions
+/// where the CPU has them, and for the baseline, where each `mul_add` (in
+/// the network, the sigmoid and `atan2`) is a call to Rust's `fma`
+/// function. Both give the same results; only the speed differs.
+#[multiversion(targets("x86_64+avx2+fma"))]
+fn fly(
+    s: &PsaSettings,
+    backend: &mut dyn PhysicsBackend,
+    network: &Network,
+    target: &Target,
+    rng: &mut Stream,
+    mut record: Option<&mut TrialRecord>,
+) -> Result<f64, PsaError> {
+    let mut outputs = [0.0; THRUSTER_COUNT];
+    let mut state = backend.planar_state();
+    let mut heading_error = wrap_angle(state.heading() - target.heading);
+    let mut points = 0.0;
+    for _ in 0..s.steps {
+        let offset = [state.position[0] - target.x, state.position[1] - target.y];
+        let mut inputs = s
+            .sensors
+            .inputs_from(offset, state.velocity, heading_error, state.omega);
+        s.noise.perturb_inputs(&mut inputs, rng);
+        network.activate(&inputs, &mut outputs);
+        s.noise.perturb_outputs(&mut outputs, rng);
+        backend.step(&outputs)?;
+        let previous_omega = state.omega;
+        state = backend.planar_state();
+        heading_error = wrap_angle(state.heading() - target.heading);
+        let step_points = s.fitness.points(&StepError {
+            x: state.position[0] - target.x,
+            y: state.position[1] - target.y,
+            heading: heading_error,
+            omega: state.omega,
+            previous_omega,
+        });
+        points += step_points;
+        if let Some(r) = record.as_deref_mut() {
+            r.states.push(state.to_body_state());
+            r.outputs.push(outputs);
+            r.points.push(step_points);
+        }
+    }
+    Ok(points)
 }
 
 /// An evaluation's fitness from its trials' fitness values: their mean,
