@@ -192,23 +192,43 @@ impl State {
 
     /// The networks `picks` assemble (pick[i]: the neuron taken from
     /// sub-population i), written over the last generation's networks.
-    fn assemble(&mut self, picks: &[Vec<usize>]) -> Result<&[Network]> {
+    fn assemble(&mut self, picks: &Picks) -> Result<&[Network]> {
         let hidden = self.subpops.len();
         let reusable = self.networks.first().is_some_and(|n| n.hidden() == hidden);
-        if !reusable || self.networks.len() != picks.len() {
+        if !reusable || self.networks.len() != picks.count() {
             let blank = Network::from_genes(
                 self.inputs,
                 self.outputs,
                 vec![0.0; hidden * (self.inputs + self.outputs)],
             )?;
-            self.networks = vec![blank; picks.len()];
+            self.networks = vec![blank; picks.count()];
         }
-        for (network, pick) in self.networks.iter_mut().zip(picks) {
+        for (network, pick) in self.networks.iter_mut().zip(picks.networks()) {
             for (i, (&k, subpop)) in pick.iter().zip(&self.subpops).enumerate() {
                 network.set_neuron(i, &subpop[k])?;
             }
         }
         Ok(&self.networks)
+    }
+}
+
+/// Which neuron of each sub-population every network of a generation
+/// takes, network after network in one flat list: network j takes neuron
+/// `flat[j * subpops + i]` of sub-population i.
+struct Picks {
+    subpops: usize,
+    flat: Vec<usize>,
+}
+
+impl Picks {
+    /// The number of networks.
+    fn count(&self) -> usize {
+        self.flat.len() / self.subpops
+    }
+
+    /// Each network's picks, one per sub-population.
+    fn networks(&self) -> std::slice::ChunksExact<'_, usize> {
+        self.flat.chunks_exact(self.subpops)
     }
 }
 
@@ -255,16 +275,18 @@ impl Esp {
     }
 
     /// Which neuron of each sub-population every network takes.
-    fn sample(&self, generation: usize, subpops: usize) -> Vec<Vec<usize>> {
+    fn sample(&self, generation: usize, subpops: usize) -> Picks {
         let s = &self.settings;
         let n = s.subpop_size;
         let mut rng = stream(self.seed, &[purpose::SAMPLE, generation as u64]);
+        let mut picks = Vec::with_capacity(s.networks_per_generation() * subpops);
         match s.sampling {
-            Sampling::Random => (0..s.networks_per_generation())
-                .map(|_| (0..subpops).map(|_| rng.random_range(0..n)).collect())
-                .collect(),
+            Sampling::Random => {
+                for _ in 0..s.networks_per_generation() * subpops {
+                    picks.push(rng.random_range(0..n));
+                }
+            }
             Sampling::Systematic => {
-                let mut picks = Vec::with_capacity(s.networks_per_generation());
                 for _ in 0..s.trials_per_neuron {
                     let orders: Vec<Vec<usize>> = (0..subpops)
                         .map(|_| {
@@ -273,11 +295,11 @@ impl Esp {
                             order
                         })
                         .collect();
-                    picks.extend((0..n).map(|k| orders.iter().map(|order| order[k]).collect()));
+                    picks.extend((0..n).flat_map(|k| orders.iter().map(move |order| order[k])));
                 }
-                picks
             }
         }
+        Picks { subpops, flat: picks }
     }
 
     fn generation<E: Evaluator>(
@@ -298,12 +320,12 @@ impl Esp {
         &self,
         evaluator: &E,
         state: &mut State,
-        picks: &[Vec<usize>],
+        picks: &Picks,
         fitness: Vec<f64>,
         generation: usize,
     ) -> Result<GenerationRecord> {
         let s = &self.settings;
-        state.evaluations += picks.len() as u64;
+        state.evaluations += picks.count() as u64;
 
         // The generation's best network updates the champion and the search's best.
         let (top, top_fitness) = best_of(&fitness);
@@ -354,13 +376,13 @@ impl Esp {
 
     /// Neuron fitness from the networks' (0 for a neuron in no network),
     /// then each sub-population sorted best first (stable).
-    fn assign_credit(&self, state: &mut State, picks: &[Vec<usize>], fitness: &[f64]) {
+    fn assign_credit(&self, state: &mut State, picks: &Picks, fitness: &[f64]) {
         let n = self.settings.subpop_size;
         for (i, subpop) in state.subpops.iter_mut().enumerate() {
             let mut sum = vec![0.0; n];
             let mut count = vec![0usize; n];
             let mut max = vec![f64::NEG_INFINITY; n];
-            for (pick, &f) in picks.iter().zip(fitness) {
+            for (pick, &f) in picks.networks().zip(fitness) {
                 let k = pick[i];
                 sum[k] += f;
                 count[k] += 1;
@@ -603,16 +625,16 @@ mod tests {
             ..EspSettings::default()
         });
         let picks = e.sample(3, 5);
-        assert_eq!(picks.len(), 400);
+        assert_eq!(picks.count(), 400);
         for i in 0..5 {
             let mut counts = [0; 40];
-            picks.iter().for_each(|p| counts[p[i]] += 1);
+            picks.networks().for_each(|p| counts[p[i]] += 1);
             assert!(counts.iter().all(|&c| c == 10), "sub-population {i}: {counts:?}");
         }
         // Random sampling: 400 picks per sub-population, unevenly spread.
         let random = esp(EspSettings::default()).sample(3, 5);
         let mut counts = [0; 40];
-        random.iter().for_each(|p| counts[p[0]] += 1);
+        random.networks().for_each(|p| counts[p[0]] += 1);
         assert_eq!(counts.iter().sum::<usize>(), 400);
         assert!(counts.iter().any(|&c| c != 10));
     }
@@ -629,7 +651,10 @@ mod tests {
             st.subpops[0] = (0..4).map(|k| vec![k as f64; 3]).collect();
             // Neuron 1: fitness 9 and 0 (mean 4.5, max 9); neuron 2: 5 and 5 (mean 5, max 5);
             // neuron 0: 1; neuron 3: in no network (0).
-            let picks = vec![vec![1], vec![1], vec![2], vec![2], vec![0]];
+            let picks = Picks {
+                subpops: 1,
+                flat: vec![1, 1, 2, 2, 0],
+            };
             e.assign_credit(&mut st, &picks, &[9.0, 0.0, 5.0, 5.0, 1.0]);
             let order: Vec<f64> = st.subpops[0].iter().map(|n| n[0]).collect();
             assert_eq!(order[0], expected_best as f64, "{credit:?}: {order:?}");
