@@ -28,10 +28,16 @@ pub fn stream(seed: u64, key: &[u64]) -> Stream {
         state = mix(state ^ mix(k));
     }
     let mut bytes = [0u8; 32];
-    for (i, chunk) in bytes.chunks_mut(8).enumerate() {
-        chunk.copy_from_slice(&mix(state.wrapping_add(i as u64)).to_le_bytes());
+    for (chunk, word) in bytes.chunks_mut(8).zip(expand(state)) {
+        chunk.copy_from_slice(&word.to_le_bytes());
     }
     ChaCha8Rng::from_seed(bytes)
+}
+
+/// Four well-mixed words from one (never all zero, as `mix` is a bijection
+/// of four distinct inputs): the seed of a 256-bit generator.
+pub(crate) fn expand(seed: u64) -> [u64; 4] {
+    [0, 1, 2, 3].map(|i| mix(seed.wrapping_add(i)))
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use psa_esp::network::Network;
+use psa_esp::numeric::NoiseSource;
 use psa_esp::physics::{BackendKind, BodyState};
 use psa_esp::psa::fitness::StepError;
 use psa_esp::psa::{
@@ -194,12 +195,12 @@ fn injected_noise_has_the_configured_mean_and_sd() {
         input_sd: 0.05,
         output_sd: 0.2,
     };
-    let mut rng = stream(9, &[]);
+    let mut source = NoiseSource::new(9);
     let n = 40_000;
     let mut samples = Vec::with_capacity(n * 6);
     for _ in 0..n {
         let mut inputs = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
-        noise.perturb_inputs(&mut inputs, &mut rng);
+        noise.perturb_inputs(&mut inputs, &mut source);
         assert_eq!(inputs[6], 1.0, "the bias gets no noise");
         samples.extend_from_slice(&inputs[..6]);
     }
@@ -212,7 +213,7 @@ fn injected_noise_has_the_configured_mean_and_sd() {
     let mut outs = Vec::with_capacity(n);
     for _ in 0..n {
         let mut u = [0.5, 0.0, 1.0, 0.5];
-        noise.perturb_outputs(&mut u, &mut rng);
+        noise.perturb_outputs(&mut u, &mut source);
         assert!(u.iter().all(|v| (0.0..=1.0).contains(v)), "clamped: {u:?}");
         outs.push(u[0]);
     }
@@ -223,10 +224,18 @@ fn injected_noise_has_the_configured_mean_and_sd() {
         (sd - 0.2).abs() < 5e-3,
         "output sd {sd} (clamping at 0.5 +- 2.5 sd barely matters)"
     );
-    // No noise configured: no draw, no change.
+    // No noise configured: no change, and no seed drawn from the stream.
     let mut u = [0.3; 4];
-    NoiseSettings::default().perturb_outputs(&mut u, &mut rng);
+    NoiseSettings::default().perturb_outputs(&mut u, &mut source);
     assert_eq!(u, [0.3; 4]);
+    let (mut drawn, mut untouched) = (stream(9, &[]), stream(9, &[]));
+    assert_eq!(NoiseSettings::default().draw_seed(&mut drawn), 0);
+    assert_eq!(drawn.random::<u64>(), untouched.random::<u64>());
+    assert_eq!(
+        noise.draw_seed(&mut drawn),
+        untouched.random::<u64>(),
+        "one word when noisy"
+    );
 }
 
 #[test]

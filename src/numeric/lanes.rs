@@ -5,7 +5,7 @@
 
 use std::ops::{Add, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Not, Sub};
 
-use super::Real;
+use super::{exponent_of, mantissa_of, unit_from_bits, Real, TWO_52};
 
 /// N `f64` values, one per lane.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -16,6 +16,11 @@ pub struct Lanes<const N: usize>(pub [f64; N]);
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(transparent)]
 pub struct LaneMask<const N: usize>(pub [u64; N]);
+
+/// N unsigned 64-bit words, one per lane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(transparent)]
+pub struct Words<const N: usize>(pub [u64; N]);
 
 /// `[f(0), f(1), ..]`: a plain loop, which (unlike `std::array::from_fn`)
 /// is always inlined into the SIMD-compiled caller.
@@ -162,7 +167,6 @@ impl<const N: usize> Real for Lanes<N> {
     #[inline(always)]
     fn exp2_int(k: Self) -> Self {
         // k + 2^52 holds k (as an integer) in its low mantissa bits.
-        const TWO_52: f64 = 4503599627370496.0;
         let shifted = (k + Self::splat(TWO_52 + 1023.0)).bits();
         Self::from_bits(from_fn(|i| (shifted[i] - TWO_52.to_bits()) << 52))
     }
@@ -173,5 +177,21 @@ impl<const N: usize> Real for Lanes<N> {
     #[inline(always)]
     fn rem_slow(self, m: f64) -> Self {
         Lanes(from_fn(|i| self.0[i] % m))
+    }
+    type Word = Words<N>;
+    #[inline(always)]
+    fn unit_from_word(w: Words<N>) -> Self {
+        Lanes(from_fn(|i| unit_from_bits(w.0[i])))
+    }
+    #[inline(always)]
+    fn mask_from_bit(w: Words<N>, bit: u32) -> LaneMask<N> {
+        LaneMask(from_fn(|i| truth((w.0[i] >> bit) & 1 != 0)))
+    }
+    #[inline(always)]
+    fn split_exponent(self) -> (Self, Self) {
+        (
+            Lanes(from_fn(|i| mantissa_of(self.0[i]))),
+            Lanes(from_fn(|i| exponent_of(self.0[i]))),
+        )
     }
 }

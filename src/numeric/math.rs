@@ -5,9 +5,11 @@
 //! fitted by Chebyshev interpolation in 50-digit arithmetic), accurate to a
 //! few units in the last place: they are the definition of the logistic unit
 //! and the heading for every backend, so that results never depend on the
-//! C library's implementation of these functions.
+//! C library's implementation of these functions. `ln` (fdlibm's) and the
+//! sine and cosine of quarter turns (Taylor series) serve the noise
+//! generator's Box-Muller transform.
 
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, LOG2_E, PI, TAU};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, LOG2_E, PI, SQRT_2, TAU};
 
 use super::Real;
 
@@ -49,6 +51,43 @@ const ATAN_S: [f64; 11] = [
 ];
 /// tan(pi/8).
 const TAN_PI_8: f64 = 0.414_213_562_373_095_03;
+/// ln(1 + f) = f - f^2/2 + s (f^2/2 + z r(z)), s = f / (2 + f), z = s^2:
+/// r's coefficients, highest first (fdlibm's `Lg7` .. `Lg1`, error < 2^-58).
+const LN_R: [f64; 7] = [
+    1.479_819_860_511_658_6e-1,
+    1.531_383_769_920_937_3e-1,
+    1.818_357_216_161_805e-1,
+    2.222_219_843_214_978_4e-1,
+    2.857_142_874_366_239e-1,
+    3.999_999_999_940_942e-1,
+    6.666_666_666_666_735e-1,
+];
+/// sin(pi f / 2) = f s(f^2) for |f| <= 1/2: s's Taylor coefficients,
+/// highest first (remainder below 1e-19).
+const SIN_QUARTER: [f64; 9] = [
+    6.066_935_731_106_195_5e-12,
+    -6.688_035_109_811_468e-10,
+    5.692_172_921_967_927e-8,
+    -3.598_843_235_212_085e-6,
+    1.604_411_847_873_598_3e-4,
+    -4.681_754_135_318_688e-3,
+    7.969_262_624_616_705e-2,
+    -6.459_640_975_062_463e-1,
+    FRAC_PI_2,
+];
+/// cos(pi f / 2) = c(f^2) for |f| <= 1/2: c's Taylor coefficients, highest
+/// first (remainder below 3e-18).
+const COS_QUARTER: [f64; 9] = [
+    6.565_963_114_979_473e-11,
+    -6.386_603_083_791_852e-9,
+    4.710_874_778_818_172e-7,
+    -2.520_204_237_306_060_7e-5,
+    9.192_602_748_394_266e-4,
+    -2.086_348_076_335_296e-2,
+    2.536_695_079_010_480_3e-1,
+    -1.233_700_550_136_169_7,
+    1.0,
+];
 
 /// Horner's scheme, highest coefficient first.
 #[inline(always)]
@@ -78,6 +117,32 @@ pub fn exp<R: Real>(x: R) -> R {
 #[inline(always)]
 pub fn sigmoid<R: Real>(x: R) -> R {
     R::splat(1.0) / (R::splat(1.0) + exp(-x))
+}
+
+/// The natural logarithm of a positive normal number (fdlibm's algorithm:
+/// x = m 2^e with m in [sqrt(1/2), sqrt(2)), then a polynomial in
+/// s = (m - 1) / (m + 1)); within one unit in the last place.
+#[inline(always)]
+pub fn ln<R: Real>(x: R) -> R {
+    let (mantissa, exponent) = x.split_exponent();
+    let high = R::splat(SQRT_2).lt(mantissa);
+    let m = R::select(high, mantissa * R::splat(0.5), mantissa);
+    let e = R::select(high, exponent + R::splat(1.0), exponent);
+    // Exact by Sterbenz's lemma: m is within a factor 2 of 1.
+    let f = m - R::splat(1.0);
+    let s = f / (R::splat(2.0) + f);
+    let z = s * s;
+    let r = z * horner(z, &LN_R);
+    let half_f_squared = R::splat(0.5) * f * f;
+    e * R::splat(LN2_HI) - ((half_f_squared - (s * (half_f_squared + r) + e * R::splat(LN2_LO))) - f)
+}
+
+/// `(sin(pi f / 2), cos(pi f / 2))` for |f| <= 1/2: the sine and cosine of
+/// `f` quarter turns, within a few units in the last place.
+#[inline(always)]
+pub fn sin_cos_quarter_turns<R: Real>(f: R) -> (R, R) {
+    let z = f * f;
+    (f * horner(z, &SIN_QUARTER), horner(z, &COS_QUARTER))
 }
 
 /// atan2(y, x) in [-pi, pi], with C's conventions for signed zeros in `y`
@@ -187,6 +252,40 @@ mod tests {
     }
 
     #[test]
+    fn ln_is_within_one_ulp_of_the_c_library() {
+        let tiny = f64::MIN_POSITIVE;
+        for x in points(0.0, 1.0, 200_000)
+            .chain(points(0.5, 2.0, 100_000))
+            .chain(points(1.0, 1e300, 100_000))
+            .chain(points(-1000.0, 0.0, 10_000).map(f64::exp))
+            .filter(|&x| x >= tiny)
+            .chain([tiny, 1.0, 2.0, SQRT_2, 1.0 - f64::EPSILON / 2.0, f64::EPSILON, f64::MAX])
+        {
+            assert!(ulps(ln(x), x.ln()) <= 1, "ln({x}) = {} vs {}", ln(x), x.ln());
+        }
+        assert_eq!(ln(1.0).to_bits(), 0.0f64.to_bits());
+    }
+
+    #[test]
+    fn sine_and_cosine_of_quarter_turns_are_within_two_ulps_of_the_c_library() {
+        for f in points(-0.5, 0.5, 200_000).chain([-0.5, 0.5, 0.0, -0.0, 1e-300, 0.25]) {
+            let (sin, cos) = sin_cos_quarter_turns(f);
+            let angle = f * FRAC_PI_2;
+            // The reference's argument is rounded; allow for that too.
+            let slack = |exact: f64| 2.0 * f64::EPSILON * exact.abs() + f64::EPSILON * angle.abs();
+            assert!(
+                (sin - angle.sin()).abs() <= slack(angle.sin()),
+                "sin of {f} quarter turns"
+            );
+            assert!(
+                (cos - angle.cos()).abs() <= slack(angle.cos()),
+                "cos of {f} quarter turns"
+            );
+        }
+        assert_eq!(sin_cos_quarter_turns(0.0), (0.0, 1.0));
+    }
+
+    #[test]
     fn fmod_and_wrap_angle_are_exact() {
         for a in points(-50.0, 50.0, 100_000).chain([TAU, -TAU, 2.0 * TAU, PI, -PI, 0.0, -0.0, 1e300]) {
             assert_eq!(fmod(a, TAU).to_bits(), (a % TAU).to_bits(), "{a}");
@@ -217,8 +316,16 @@ mod tests {
                 }
             }
             let angles = atan2(lanes, rotated);
+            let logarithms = ln(lanes.abs());
+            let (sines, cosines) = sin_cos_quarter_turns(lanes * Lanes::splat(1.0 / 80.0));
             for i in 0..8 {
                 assert_eq!(angles[i].to_bits(), atan2(chunk[i], rotated[i]).to_bits());
+                assert_eq!(logarithms[i].to_bits(), ln(chunk[i].abs()).to_bits());
+                let (sin, cos) = sin_cos_quarter_turns(chunk[i] * (1.0 / 80.0));
+                assert_eq!(
+                    (sines[i].to_bits(), cosines[i].to_bits()),
+                    (sin.to_bits(), cos.to_bits())
+                );
             }
         }
     }

@@ -12,8 +12,9 @@
 //! fitness is bit-identical on both paths and on every [`SimdLevel`]; the
 //! tests hold the paths to that on thousands of random networks.
 //!
-//! Random draws (random starts, input and output noise) stay scalar, lane by
-//! lane, from each network's own stream in the scalar path's order. A lane
+//! Random starts and the seeds of the noise sources are drawn lane by lane
+//! from each network's own stream, in the scalar path's order; the noise
+//! itself comes from one [`NoiseSource`] per lane, generated in SIMD. A lane
 //! whose thrust turns NaN (only possible with absurd settings, such as an
 //! input scale that overflows) is re-run on the scalar path, which reports
 //! the error it raises.
@@ -24,10 +25,9 @@ use super::fitness::StepError;
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::network::Network;
-use crate::numeric::{clamp_unit, sigmoid, wrap_angle, LaneMask, Lanes, Real, SimdLevel};
+use crate::numeric::{sigmoid, wrap_angle, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::Stream;
-use rand_distr::{Distribution, StandardNormal};
 
 /// Networks evaluated in lockstep by one call of the kernel: four AVX-512
 /// registers per value, enough independent work to hide the latency of the
@@ -74,23 +74,15 @@ struct Flight<'a, const N: usize> {
     weights: &'a BlockWeights<N>,
 }
 
-/// Draws `sd * N(0, 1)` onto lane `lane` of each value, in order.
-fn add_noise<const N: usize>(values: &mut [Lanes<N>], lane: usize, sd: f64, rng: &mut Stream) {
-    for v in values {
-        let noise: f64 = StandardNormal.sample(rng);
-        v[lane] += sd * noise;
-    }
-}
-
-/// One trial of every lane from `state` towards `target` (x, y, heading);
-/// `rngs[l]` is lane l's stream (lanes beyond `rngs.len()` are padding and
-/// draw nothing). Returns the points and which lanes kept a valid thrust.
+/// One trial of every lane from `state` towards `target` (x, y, heading),
+/// with lane l's noise from lane l of `noise`. Returns the points and which
+/// lanes kept a valid thrust.
 #[inline(always)]
 fn fly<const N: usize>(
     flight: &Flight<N>,
     state: &mut PlanarState<Lanes<N>>,
     target: &[Lanes<N>; 3],
-    rngs: &mut [Stream],
+    noise: &mut NoiseSource<Words<N>>,
 ) -> (Lanes<N>, LaneMask<N>) {
     type V<const N: usize> = Lanes<N>;
     let s = flight.settings;
@@ -104,11 +96,7 @@ fn fly<const N: usize>(
         let mut inputs = s
             .sensors
             .inputs_from(offset, state.velocity, heading_error, state.omega);
-        if s.noise.input_sd > 0.0 {
-            for (lane, rng) in rngs.iter_mut().enumerate() {
-                add_noise(&mut inputs[..INPUT_COUNT - 1], lane, s.noise.input_sd, rng);
-            }
-        }
+        s.noise.perturb_inputs(&mut inputs, noise);
         let mut outputs = [zero; THRUSTER_COUNT];
         for k in 0..weights.hidden {
             let w_in = &weights.input[k * INPUT_COUNT..][..INPUT_COUNT];
@@ -125,13 +113,8 @@ fn fly<const N: usize>(
         for o in &mut outputs {
             *o = sigmoid(*o);
         }
-        if s.noise.output_sd > 0.0 {
-            for (lane, rng) in rngs.iter_mut().enumerate() {
-                add_noise(&mut outputs, lane, s.noise.output_sd, rng);
-            }
-        }
-        for o in &mut outputs {
-            *o = clamp_unit(*o);
+        s.noise.perturb_outputs(&mut outputs, noise);
+        for o in &outputs {
             valid = valid & o.le(one);
         }
         let previous_omega = state.omega;
@@ -158,9 +141,9 @@ macro_rules! kernel {
             flight: &Flight<$n>,
             state: &mut PlanarState<Lanes<$n>>,
             target: &[Lanes<$n>; 3],
-            rngs: &mut [Stream],
+            noise: &mut NoiseSource<Words<$n>>,
         ) -> (Lanes<$n>, LaneMask<$n>) {
-            fly(flight, state, target, rngs)
+            fly(flight, state, target, noise)
         }
     };
 }
@@ -186,12 +169,12 @@ macro_rules! kernels {
             flight: &Flight<$n>,
             state: &mut PlanarState<Lanes<$n>>,
             target: &[Lanes<$n>; 3],
-            rngs: &mut [Stream],
+            noise: &mut NoiseSource<Words<$n>>,
         ) -> (Lanes<$n>, LaneMask<$n>) {
             match level {
-                SimdLevel::Avx512 => $avx512(flight, state, target, rngs),
-                SimdLevel::Avx2 => $avx2(flight, state, target, rngs),
-                SimdLevel::Portable => $portable(flight, state, target, rngs),
+                SimdLevel::Avx512 => $avx512(flight, state, target, noise),
+                SimdLevel::Avx2 => $avx2(flight, state, target, noise),
+                SimdLevel::Portable => $portable(flight, state, target, noise),
             }
         }
     };
@@ -207,8 +190,13 @@ kernels!(
 );
 
 /// A kernel of width N run on a [`SimdLevel`].
-type Kernel<const N: usize> =
-    fn(SimdLevel, &Flight<N>, &mut PlanarState<Lanes<N>>, &[Lanes<N>; 3], &mut [Stream]) -> (Lanes<N>, LaneMask<N>);
+type Kernel<const N: usize> = fn(
+    SimdLevel,
+    &Flight<N>,
+    &mut PlanarState<Lanes<N>>,
+    &[Lanes<N>; 3],
+    &mut NoiseSource<Words<N>>,
+) -> (Lanes<N>, LaneMask<N>);
 
 /// Evaluates networks on one task in blocks of [`LANES`], on the `native`
 /// backend's physics, with the best [`SimdLevel`] of the CPU.
@@ -304,15 +292,18 @@ impl BatchRunner {
         for t in 0..s.trials {
             let mut starts = [PlanarState::from_body_state(&Default::default()); N];
             let mut targets = [[0.0; 3]; N];
+            let mut seeds = [0; N];
             for (lane, rng) in rngs.iter_mut().enumerate() {
                 let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
                 start.validate()?;
                 starts[lane] = PlanarState::from_body_state(&start);
                 targets[lane] = [target.x, target.y, target.heading];
+                seeds[lane] = s.noise.draw_seed(rng);
             }
             for lane in networks.len()..N {
                 (starts[lane], targets[lane]) = (starts[0], targets[0]);
             }
+            let mut noise = NoiseSource::from_seeds(&seeds);
             let lanes = |f: &dyn Fn(usize) -> f64| Lanes(std::array::from_fn(f));
             let mut state = PlanarState {
                 position: [lanes(&|l| starts[l].position[0]), lanes(&|l| starts[l].position[1])],
@@ -321,7 +312,7 @@ impl BatchRunner {
                 omega: lanes(&|l| starts[l].omega),
             };
             let target = [0, 1, 2].map(|i| lanes(&|l| targets[l][i]));
-            let (points, ok) = fly(self.level, &flight, &mut state, &target, rngs);
+            let (points, ok) = fly(self.level, &flight, &mut state, &target, &mut noise);
             valid = valid & ok;
             for lane in 0..networks.len() {
                 trials[lane * s.trials + t] = 100.0 * points[lane] / maximum;

@@ -3,11 +3,10 @@
 //! scaled, with Gaussian noise on inputs and outputs.
 
 use rand::Rng;
-use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 use super::task::Target;
-use crate::numeric::{clamp_unit, Real};
+use crate::numeric::{clamp_unit, NoiseSource, Real};
 use crate::physics::{wrap_angle, BodyState};
 
 /// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
@@ -92,7 +91,8 @@ impl SensorSettings {
     }
 }
 
-/// Gaussian white noise on the network's inputs (not the bias) and outputs.
+/// Gaussian white noise on the network's inputs (not the bias) and outputs,
+/// drawn from a [`NoiseSource`] per trial.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseSettings {
@@ -113,24 +113,38 @@ impl NoiseSettings {
         Ok(())
     }
 
+    /// Whether any noise is configured.
+    pub fn is_active(&self) -> bool {
+        self.input_sd > 0.0 || self.output_sd > 0.0
+    }
+
+    /// The seed of a trial's [`NoiseSource`]: one word drawn from `rng` when
+    /// noise is configured. Without noise nothing is drawn (the source then
+    /// goes unused), so noiseless runs consume their streams as before.
+    pub fn draw_seed(&self, rng: &mut impl Rng) -> u64 {
+        if self.is_active() {
+            rng.next_u64()
+        } else {
+            0
+        }
+    }
+
     /// Adds input noise to every input but the last (the bias).
-    pub fn perturb_inputs(&self, inputs: &mut [f64], rng: &mut impl Rng) {
+    #[inline(always)]
+    pub fn perturb_inputs<R: Real>(&self, inputs: &mut [R], source: &mut NoiseSource<R::Word>) {
         if self.input_sd > 0.0 {
             let n = inputs.len() - 1;
-            for x in &mut inputs[..n] {
-                let noise: f64 = StandardNormal.sample(rng);
-                *x += self.input_sd * noise;
-            }
+            source.add_scaled(&mut inputs[..n], self.input_sd);
         }
     }
 
     /// Adds output noise and clamps every output to [0, 1].
-    pub fn perturb_outputs(&self, outputs: &mut [f64], rng: &mut impl Rng) {
+    #[inline(always)]
+    pub fn perturb_outputs<R: Real>(&self, outputs: &mut [R], source: &mut NoiseSource<R::Word>) {
+        if self.output_sd > 0.0 {
+            source.add_scaled(outputs, self.output_sd);
+        }
         for u in outputs {
-            if self.output_sd > 0.0 {
-                let noise: f64 = StandardNormal.sample(rng);
-                *u += self.output_sd * noise;
-            }
             *u = clamp_unit(*u);
         }
     }

@@ -10,6 +10,7 @@ use super::sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
 use super::task::{Target, Task, TaskSettings};
 use super::{BodySettings, THRUSTER_COUNT};
 use crate::network::Network;
+use crate::numeric::NoiseSource;
 use crate::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, PhysicsError, StepSettings};
 use crate::rng::Stream;
 
@@ -166,7 +167,7 @@ impl TrialRunner {
     }
 
     /// One trial; returns its points. Draws the random start (if any), then
-    /// the noise, from `rng`. Fills `record` when given.
+    /// the noise source's seed (if noise is configured), from `rng`. Fills `record` when given.
     pub fn run_trial(
         &mut self,
         network: &Network,
@@ -186,7 +187,8 @@ impl TrialRunner {
             };
             r.states.push(start);
         }
-        fly(s, self.backend.as_mut(), network, &target, rng, record)
+        let mut noise = NoiseSource::new(s.noise.draw_seed(rng));
+        fly(s, self.backend.as_mut(), network, &target, &mut noise, record)
     }
 
     /// The fitness of every trial, in % of the theoretical maximum.
@@ -217,7 +219,7 @@ fn fly(
     backend: &mut dyn PhysicsBackend,
     network: &Network,
     target: &Target,
-    rng: &mut Stream,
+    noise: &mut NoiseSource<u64>,
     mut record: Option<&mut TrialRecord>,
 ) -> Result<f64, PsaError> {
     let mut outputs = [0.0; THRUSTER_COUNT];
@@ -229,9 +231,9 @@ fn fly(
         let mut inputs = s
             .sensors
             .inputs_from(offset, state.velocity, heading_error, state.omega);
-        s.noise.perturb_inputs(&mut inputs, rng);
+        s.noise.perturb_inputs(&mut inputs, noise);
         network.activate(&inputs, &mut outputs);
-        s.noise.perturb_outputs(&mut outputs, rng);
+        s.noise.perturb_outputs(&mut outputs, noise);
         backend.step(&outputs)?;
         let previous_omega = state.omega;
         state = backend.planar_state();
