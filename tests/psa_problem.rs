@@ -209,20 +209,22 @@ fn injected_noise_has_the_configured_mean_and_sd() {
     // Standard errors: mean 0.05 / sqrt(240000) = 1e-4; sd about 7e-5.
     assert!(mean.abs() < 5e-4, "mean {mean}");
     assert!((sd - 0.05).abs() < 5e-4, "sd {sd}");
-    // Outputs: noise around 0.5 (far from the clamps), then clamping.
+    // Outputs: noise only (the trial clamps afterwards), half of it below 0 at 0.
     let mut outs = Vec::with_capacity(n);
+    let mut below_zero = 0;
     for _ in 0..n {
         let mut u = [0.5, 0.0, 1.0, 0.5];
         noise.perturb_outputs(&mut u, &mut source);
-        assert!(u.iter().all(|v| (0.0..=1.0).contains(v)), "clamped: {u:?}");
+        below_zero += usize::from(u[1] < 0.0);
         outs.push(u[0]);
     }
     let mean = outs.iter().sum::<f64>() / n as f64;
     let sd = (outs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
     assert!((mean - 0.5).abs() < 5e-3, "output mean {mean}");
+    assert!((sd - 0.2).abs() < 5e-3, "output sd {sd}");
     assert!(
-        (sd - 0.2).abs() < 5e-3,
-        "output sd {sd} (clamping at 0.5 +- 2.5 sd barely matters)"
+        (below_zero as f64 / n as f64 - 0.5).abs() < 0.02,
+        "{below_zero} below 0"
     );
     // No noise configured: no change, and no seed drawn from the stream.
     let mut u = [0.3; 4];
@@ -236,6 +238,34 @@ fn injected_noise_has_the_configured_mean_and_sd() {
         untouched.random::<u64>(),
         "one word when noisy"
     );
+}
+
+#[test]
+fn thrust_under_output_noise_is_clamped_to_the_unit_interval() {
+    // A network at full thrust, noise of sd 0.5: about half the commands
+    // would exceed 1 and some fall below 0; the trial clamps them all.
+    let settings = PsaSettings {
+        backend: BackendKind::Native,
+        noise: NoiseSettings {
+            input_sd: 0.0,
+            output_sd: 0.5,
+        },
+        ..PsaSettings::default()
+    };
+    let mut runner = TrialRunner::new(&settings, Task::StopAtPosition).unwrap();
+    let mut record = TrialRecord::default();
+    runner
+        .run_trial(&constant_network(1.0), &mut stream(4, &[]), Some(&mut record))
+        .unwrap();
+    let commands: Vec<f64> = record.outputs.iter().flatten().copied().collect();
+    assert!(commands.iter().all(|u| (0.0..=1.0).contains(u)));
+    let at_one = commands.iter().filter(|&&u| u == 1.0).count();
+    assert!(
+        at_one > commands.len() / 3,
+        "{at_one} of {} clamped to 1",
+        commands.len()
+    );
+    assert!(commands.iter().any(|&u| u > 0.0 && u < 1.0));
 }
 
 #[test]

@@ -25,7 +25,7 @@ use super::fitness::StepError;
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::network::Network;
-use crate::numeric::{sigmoid, wrap_angle, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words};
+use crate::numeric::{clamp_unit, sigmoid, wrap_angle, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::Stream;
 
@@ -114,7 +114,8 @@ fn fly<const N: usize>(
             *o = sigmoid(*o);
         }
         s.noise.perturb_outputs(&mut outputs, noise);
-        for o in &outputs {
+        for o in &mut outputs {
+            *o = clamp_unit(*o);
             valid = valid & o.le(one);
         }
         let previous_omega = state.omega;

@@ -6,7 +6,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use super::task::Target;
-use crate::numeric::{clamp_unit, NoiseSource, Real};
+use crate::numeric::{NoiseSource, Real};
 use crate::physics::{wrap_angle, BodyState};
 
 /// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
@@ -138,14 +138,12 @@ impl NoiseSettings {
         }
     }
 
-    /// Adds output noise and clamps every output to [0, 1].
+    /// Adds output noise; the caller then clamps every output to [0, 1]
+    /// ([`clamp_unit`](crate::numeric::clamp_unit)).
     #[inline(always)]
     pub fn perturb_outputs<R: Real>(&self, outputs: &mut [R], source: &mut NoiseSource<R::Word>) {
         if self.output_sd > 0.0 {
             source.add_scaled(outputs, self.output_sd);
-        }
-        for u in outputs {
-            *u = clamp_unit(*u);
         }
     }
 }

@@ -10,7 +10,7 @@ use super::sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
 use super::task::{Target, Task, TaskSettings};
 use super::{BodySettings, THRUSTER_COUNT};
 use crate::network::Network;
-use crate::numeric::NoiseSource;
+use crate::numeric::{clamp_unit, NoiseSource};
 use crate::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, PhysicsError, StepSettings};
 use crate::rng::Stream;
 
@@ -234,6 +234,7 @@ fn fly(
         s.noise.perturb_inputs(&mut inputs, noise);
         network.activate(&inputs, &mut outputs);
         s.noise.perturb_outputs(&mut outputs, noise);
+        outputs = outputs.map(clamp_unit);
         backend.step(&outputs)?;
         let previous_omega = state.omega;
         state = backend.planar_state();
