@@ -75,10 +75,11 @@ struct Flight<'a, const N: usize> {
 }
 
 /// One trial of every lane from `state` towards `target` (x, y, heading),
-/// with lane l's noise from lane l of `noise`. Returns the points and which
-/// lanes kept a valid thrust.
+/// with lane l's noise from lane l of `noise` if `NOISY` (compiled apart, so
+/// that the noise code costs noiseless flights nothing). Returns the points
+/// and which lanes kept a valid thrust.
 #[inline(always)]
-fn fly<const N: usize>(
+fn fly<const N: usize, const NOISY: bool>(
     flight: &Flight<N>,
     state: &mut PlanarState<Lanes<N>>,
     target: &[Lanes<N>; 3],
@@ -96,7 +97,9 @@ fn fly<const N: usize>(
         let mut inputs = s
             .sensors
             .inputs_from(offset, state.velocity, heading_error, state.omega);
-        s.noise.perturb_inputs(&mut inputs, noise);
+        if NOISY {
+            s.noise.perturb_inputs(&mut inputs, noise);
+        }
         let mut outputs = [zero; THRUSTER_COUNT];
         for k in 0..weights.hidden {
             let w_in = &weights.input[k * INPUT_COUNT..][..INPUT_COUNT];
@@ -113,7 +116,9 @@ fn fly<const N: usize>(
         for o in &mut outputs {
             *o = sigmoid(*o);
         }
-        s.noise.perturb_outputs(&mut outputs, noise);
+        if NOISY {
+            s.noise.perturb_outputs(&mut outputs, noise);
+        }
         for o in &mut outputs {
             *o = clamp_unit(*o);
             valid = valid & o.le(one);
@@ -133,10 +138,11 @@ fn fly<const N: usize>(
     (points, valid)
 }
 
-/// The kernel of width `$n` as a function with the attributes given (a
-/// `multiversion` target list, or none for the portable build).
+/// The kernel of width `$n`, with or without noise, as a function with the
+/// attributes given (a `multiversion` target list, or none for the portable
+/// build).
 macro_rules! kernel {
-    ($(#[$attr:meta])* $name:ident, $n:expr) => {
+    ($(#[$attr:meta])* $name:ident, $n:expr, $noisy:expr) => {
         $(#[$attr])*
         fn $name(
             flight: &Flight<$n>,
@@ -144,51 +150,53 @@ macro_rules! kernel {
             target: &[Lanes<$n>; 3],
             noise: &mut NoiseSource<Words<$n>>,
         ) -> (Lanes<$n>, LaneMask<$n>) {
-            fly(flight, state, target, noise)
+            fly::<$n, $noisy>(flight, state, target, noise)
         }
     };
 }
 
-/// The kernel of width `$n` compiled for each [`SimdLevel`], and a
-/// function that runs the one asked for.
+/// A module `$module` holding the kernel of width `$n` (noisy or not)
+/// compiled for each [`SimdLevel`], and `run`, which runs the one asked for.
 macro_rules! kernels {
-    ($run:ident, $avx512:ident, $avx2:ident, $portable:ident, $n:expr) => {
-        kernel!(
-            #[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))]
-            $avx512,
-            $n
-        );
-        kernel!(
-            #[multiversion(targets("x86_64+avx2+fma"))]
-            $avx2,
-            $n
-        );
-        kernel!($portable, $n);
+    ($module:ident, $n:expr, $noisy:expr) => {
+        mod $module {
+            use super::*;
 
-        fn $run(
-            level: SimdLevel,
-            flight: &Flight<$n>,
-            state: &mut PlanarState<Lanes<$n>>,
-            target: &[Lanes<$n>; 3],
-            noise: &mut NoiseSource<Words<$n>>,
-        ) -> (Lanes<$n>, LaneMask<$n>) {
-            match level {
-                SimdLevel::Avx512 => $avx512(flight, state, target, noise),
-                SimdLevel::Avx2 => $avx2(flight, state, target, noise),
-                SimdLevel::Portable => $portable(flight, state, target, noise),
+            kernel!(
+                #[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))]
+                avx512,
+                $n,
+                $noisy
+            );
+            kernel!(
+                #[multiversion(targets("x86_64+avx2+fma"))]
+                avx2,
+                $n,
+                $noisy
+            );
+            kernel!(portable, $n, $noisy);
+
+            pub(super) fn run(
+                level: SimdLevel,
+                flight: &Flight<$n>,
+                state: &mut PlanarState<Lanes<$n>>,
+                target: &[Lanes<$n>; 3],
+                noise: &mut NoiseSource<Words<$n>>,
+            ) -> (Lanes<$n>, LaneMask<$n>) {
+                match level {
+                    SimdLevel::Avx512 => avx512(flight, state, target, noise),
+                    SimdLevel::Avx2 => avx2(flight, state, target, noise),
+                    SimdLevel::Portable => portable(flight, state, target, noise),
+                }
             }
         }
     };
 }
 
-kernels!(fly_wide, fly_wide_avx512, fly_wide_avx2, fly_wide_portable, LANES);
-kernels!(
-    fly_narrow,
-    fly_narrow_avx512,
-    fly_narrow_avx2,
-    fly_narrow_portable,
-    NARROW_LANES
-);
+kernels!(wide, LANES, false);
+kernels!(wide_noisy, LANES, true);
+kernels!(narrow, NARROW_LANES, false);
+kernels!(narrow_noisy, NARROW_LANES, true);
 
 /// A kernel of width N run on a [`SimdLevel`].
 type Kernel<const N: usize> = fn(
@@ -256,10 +264,13 @@ impl BatchRunner {
             let width = if left > 2 * NARROW_LANES { LANES } else { NARROW_LANES };
             let end = start + left.min(width);
             let (block, streams) = (&networks[start..end], &mut rngs[start..end]);
+            let noisy = self.settings.noise.is_active();
             if width == LANES {
-                self.evaluate_block::<LANES>(fly_wide, block, streams, &mut fitness)?;
+                let fly = if noisy { wide_noisy::run } else { wide::run };
+                self.evaluate_block::<LANES>(fly, block, streams, &mut fitness)?;
             } else {
-                self.evaluate_block::<NARROW_LANES>(fly_narrow, block, streams, &mut fitness)?;
+                let fly = if noisy { narrow_noisy::run } else { narrow::run };
+                self.evaluate_block::<NARROW_LANES>(fly, block, streams, &mut fitness)?;
             }
             start = end;
         }

@@ -209,12 +209,50 @@ impl TrialRunner {
 /// The steps of one trial from the backend's current state; returns the
 /// points and fills `record` (already holding the start) when given.
 ///
-/// Compiled twice, and picked at run time: with AVX2 and FMA instructions
-/// where the CPU has them, and for the baseline, where each `mul_add` (in
-/// the network, the sigmoid and `atan2`) is a call to Rust's `fma`
-/// function. Both give the same results; only the speed differs.
-#[multiversion(targets("x86_64+avx2+fma"))]
+/// The loop is compiled apart with and without noise, so that the noise code
+/// costs noiseless trials nothing, and each of those twice, picked at run
+/// time: with AVX2 and FMA instructions where the CPU has them, and for the
+/// baseline, where each `mul_add` (in the network, the sigmoid and `atan2`)
+/// is a call to Rust's `fma` function. Both give the same results; only the
+/// speed differs.
 fn fly(
+    s: &PsaSettings,
+    backend: &mut dyn PhysicsBackend,
+    network: &Network,
+    target: &Target,
+    noise: &mut NoiseSource<u64>,
+    record: Option<&mut TrialRecord>,
+) -> Result<f64, PsaError> {
+    if s.noise.is_active() {
+        fly_noisy(s, backend, network, target, noise, record)
+    } else {
+        fly_clean(s, backend, network, target, noise, record)
+    }
+}
+
+/// Declares `$name`, [`fly_steps`] with or without noise, multiversioned.
+macro_rules! trial_loop {
+    ($name:ident, $noisy:expr) => {
+        #[multiversion(targets("x86_64+avx2+fma"))]
+        fn $name(
+            s: &PsaSettings,
+            backend: &mut dyn PhysicsBackend,
+            network: &Network,
+            target: &Target,
+            noise: &mut NoiseSource<u64>,
+            record: Option<&mut TrialRecord>,
+        ) -> Result<f64, PsaError> {
+            fly_steps::<$noisy>(s, backend, network, target, noise, record)
+        }
+    };
+}
+
+trial_loop!(fly_clean, false);
+trial_loop!(fly_noisy, true);
+
+/// The loop of [`fly`], with noise if `NOISY`.
+#[inline(always)]
+fn fly_steps<const NOISY: bool>(
     s: &PsaSettings,
     backend: &mut dyn PhysicsBackend,
     network: &Network,
@@ -231,10 +269,16 @@ fn fly(
         let mut inputs = s
             .sensors
             .inputs_from(offset, state.velocity, heading_error, state.omega);
-        s.noise.perturb_inputs(&mut inputs, noise);
+        if NOISY {
+            s.noise.perturb_inputs(&mut inputs, noise);
+        }
         network.activate(&inputs, &mut outputs);
-        s.noise.perturb_outputs(&mut outputs, noise);
-        outputs = outputs.map(clamp_unit);
+        if NOISY {
+            s.noise.perturb_outputs(&mut outputs, noise);
+        }
+        for u in &mut outputs {
+            *u = clamp_unit(*u);
+        }
         backend.step(&outputs)?;
         let previous_omega = state.omega;
         state = backend.planar_state();
