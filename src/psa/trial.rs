@@ -188,6 +188,7 @@ impl TrialRunner {
             r.states.push(start);
         }
         let mut noise = NoiseSource::new(s.noise.draw_seed(rng));
+        let fly = if s.noise.is_active() { fly_noisy } else { fly_clean };
         fly(s, self.backend.as_mut(), network, &target, &mut noise, record)
     }
 
@@ -206,8 +207,9 @@ impl TrialRunner {
     }
 }
 
-/// The steps of one trial from the backend's current state; returns the
-/// points and fills `record` (already holding the start) when given.
+/// Declares `$name`: the steps of one trial from the backend's current
+/// state, with noise or without ([`fly_steps`]); it returns the points and
+/// fills `record` (already holding the start) when given.
 ///
 /// The loop is compiled apart with and without noise, so that the noise code
 /// costs noiseless trials nothing, and each of those twice, picked at run
@@ -215,22 +217,6 @@ impl TrialRunner {
 /// baseline, where each `mul_add` (in the network, the sigmoid and `atan2`)
 /// is a call to Rust's `fma` function. Both give the same results; only the
 /// speed differs.
-fn fly(
-    s: &PsaSettings,
-    backend: &mut dyn PhysicsBackend,
-    network: &Network,
-    target: &Target,
-    noise: &mut NoiseSource<u64>,
-    record: Option<&mut TrialRecord>,
-) -> Result<f64, PsaError> {
-    if s.noise.is_active() {
-        fly_noisy(s, backend, network, target, noise, record)
-    } else {
-        fly_clean(s, backend, network, target, noise, record)
-    }
-}
-
-/// Declares `$name`, [`fly_steps`] with or without noise, multiversioned.
 macro_rules! trial_loop {
     ($name:ident, $noisy:expr) => {
         #[multiversion(targets("x86_64+avx2+fma"))]
@@ -250,7 +236,7 @@ macro_rules! trial_loop {
 trial_loop!(fly_clean, false);
 trial_loop!(fly_noisy, true);
 
-/// The loop of [`fly`], with noise if `NOISY`.
+/// The loop of `fly_clean` and `fly_noisy`, with noise if `NOISY`.
 #[inline(always)]
 fn fly_steps<const NOISY: bool>(
     s: &PsaSettings,
