@@ -257,6 +257,7 @@ impl BatchRunner {
     pub fn evaluate(&self, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>, PsaError> {
         assert_eq!(networks.len(), rngs.len(), "one stream per network");
         let mut fitness = Vec::with_capacity(networks.len());
+        let noisy = self.settings.noise.is_active();
         let mut start = 0;
         while start < networks.len() {
             let left = networks.len() - start;
@@ -264,7 +265,6 @@ impl BatchRunner {
             let width = if left > 2 * NARROW_LANES { LANES } else { NARROW_LANES };
             let end = start + left.min(width);
             let (block, streams) = (&networks[start..end], &mut rngs[start..end]);
-            let noisy = self.settings.noise.is_active();
             if width == LANES {
                 let fly = if noisy { wide_noisy::run } else { wide::run };
                 self.evaluate_block::<LANES>(fly, block, streams, &mut fitness)?;
