@@ -119,13 +119,18 @@ fn crosscheck_reports_every_backend_against_ode() {
 }
 
 #[test]
-fn bench_prints_ns_per_step_for_every_backend() {
+fn bench_prints_ns_per_step_for_every_backend_and_the_logistic_share() {
     let o = psa_esp(&["bench", "--steps", "1000", "--rounds", "1", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let rows = report["physics_step"].as_array().unwrap();
     assert_eq!(rows.len(), psa_esp::physics::BackendKind::available().len());
     assert!(rows.iter().all(|r| r["median_ns_per_step"].as_f64().unwrap() > 0.0));
+    let logistic = &report["logistic_function"];
+    assert!(logistic["ns_per_value"].as_f64().unwrap() > 0.0, "{logistic}");
+    assert_eq!(logistic["per_network_step"], 9, "{logistic}");
+    let share = logistic["percent_of_batched_network_step"].as_f64().unwrap();
+    assert!(share > 0.0 && share.is_finite(), "{logistic}");
 }
 
 /// A hand-made 7-3-4 spin damper: neuron 0 fires thrusters 2 and 3

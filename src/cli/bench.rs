@@ -2,12 +2,14 @@
 //! (interleaved so that machine noise hits them alike), ns per
 //! network-step and evaluations per second of every evaluation path (ode,
 //! native scalar, native batched on each SIMD level, rapier) on 1 and 2
-//! threads, and the 2-thread speed-up and algorithm overhead of `evolve`
-//! and `replicate` (see [`super::bench_runs`]).
+//! threads, the logistic function alone on the batched path (the bulk of
+//! its arithmetic), and the 2-thread speed-up and algorithm overhead of
+//! `evolve` and `replicate` (see [`super::bench_runs`]).
 
 use std::time::Instant;
 
 use anyhow::Result;
+use multiversion::multiversion;
 use serde::Serialize;
 
 use super::bench_runs::{algorithm_overhead, evolve_scaling, replicate_scaling};
@@ -15,9 +17,13 @@ use crate::evolution::evaluate_all;
 use crate::evolution::operators::random_genes;
 use crate::experiment::PsaEvaluator;
 use crate::network::Network;
-use crate::numeric::SimdLevel;
+use crate::numeric::{sigmoid, Lanes, SimdLevel};
 use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
+use crate::psa::batch::LANES;
 use crate::psa::{BodySettings, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
+
+/// Hidden neurons of the benchmark's networks (the paper's 7-5-4 network).
+const HIDDEN: usize = 5;
 
 /// Arguments of `bench`.
 #[derive(Debug, clap::Args)]
@@ -89,7 +95,7 @@ struct EvaluationTiming {
     ns_per_network_step_1_thread: f64,
 }
 
-/// Random 7-5-4 networks, weights uniform in (-6, 6) as ESP starts them.
+/// Random 7-[`HIDDEN`]-4 networks, weights uniform in (-6, 6) as ESP starts them.
 fn random_networks(count: u64) -> Result<Vec<Network>> {
     let mut rng = crate::rng::stream(1, &[]);
     (0..count)
@@ -97,7 +103,7 @@ fn random_networks(count: u64) -> Result<Vec<Network>> {
             Ok(Network::from_genes(
                 INPUT_COUNT,
                 THRUSTER_COUNT,
-                random_genes(&mut rng, 5 * 11, 6.0),
+                random_genes(&mut rng, HIDDEN * (INPUT_COUNT + THRUSTER_COUNT), 6.0),
             )?)
         })
         .collect()
@@ -120,6 +126,47 @@ fn evaluations_per_second(path: EvaluationPath, networks: &[Network], threads: u
     }
     rates.sort_by(f64::total_cmp);
     Ok(rates[rates.len() / 2])
+}
+
+/// The logistic function alone, as the batched path computes it: blocks of
+/// [`LANES`] values on the CPU's best SIMD level.
+#[derive(Debug, Serialize)]
+struct LogisticTiming {
+    ns_per_value: f64,
+    /// Logistic units in a network-step: the hidden and the output neurons.
+    per_network_step: usize,
+    /// Their share of the batched path's network-step on the best level.
+    percent_of_batched_network_step: f64,
+}
+
+/// Applies the logistic function `rounds` times over to every value.
+#[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl", "x86_64+avx2+fma"))]
+fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
+    for _ in 0..rounds {
+        for v in values.iter_mut() {
+            *v = sigmoid(*v);
+        }
+    }
+}
+
+/// ns per value of the logistic function (median of `rounds` rounds of
+/// about 4 million values, which stay in the first-level cache).
+fn logistic_ns_per_value(rounds: u64) -> f64 {
+    const BLOCKS: usize = 64;
+    const REPEATS: usize = 2000;
+    let mut values: Vec<Lanes<LANES>> = (0..BLOCKS)
+        .map(|b| Lanes(std::array::from_fn(|l| ((b * LANES + l) % 97) as f64 / 12.0 - 4.0)))
+        .collect();
+    let mut samples: Vec<f64> = (0..rounds)
+        .map(|_| {
+            let start = Instant::now();
+            logistic_rounds(std::hint::black_box(&mut values), REPEATS);
+            start.elapsed().as_nanos() as f64 / (BLOCKS * LANES * REPEATS) as f64
+        })
+        .collect();
+    std::hint::black_box(&values);
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
 }
 
 /// One backend's timing.
@@ -236,6 +283,19 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    let best_batched = evaluations
+        .iter()
+        .filter(|e| e.path.simd.is_some())
+        .map(|e| e.ns_per_network_step_1_thread)
+        .next_back();
+    let logistic_ns = logistic_ns_per_value(args.rounds);
+    let per_network_step = HIDDEN + THRUSTER_COUNT;
+    let logistic = LogisticTiming {
+        ns_per_value: logistic_ns,
+        per_network_step,
+        percent_of_batched_network_step: best_batched
+            .map_or(f64::NAN, |ns| 100.0 * per_network_step as f64 * logistic_ns / ns),
+    };
     let generations = args.generations as usize;
     let evolve = evolve_scaling(generations, args.rounds)?;
     let replicate = replicate_scaling(generations, args.rounds)?;
@@ -252,6 +312,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             "networks_per_round": args.networks,
             "psa_evaluation": evaluations,
             "simd_level_in_use": SimdLevel::detect(),
+            "logistic_function": logistic,
             "evolve": evolve,
             "replicate": replicate,
             "algorithm_overhead": overhead,
@@ -310,6 +371,12 @@ pub fn run(args: BenchArgs) -> Result<i32> {
                 e.ns_per_network_step_1_thread
             );
         }
+        say!(
+            "logistic function alone (blocks of {LANES} values, best SIMD level): {:.2} ns per value; the {} of a network-step take {:.1} % of the batched network-step",
+            logistic.ns_per_value,
+            logistic.per_network_step,
+            logistic.percent_of_batched_network_step
+        );
         for (what, s) in [("evolve", &evolve), ("replicate", &replicate)] {
             say!(
                 "{what}: {}: {:.3} s on 1 thread, {:.3} s on 2 threads (median of {}): speed-up {:.2}x",
