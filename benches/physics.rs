@@ -1,7 +1,9 @@
 //! ns per physics step of each backend, our ODE path against the bare ODE
-//! calls, and PSA network evaluations on every path: ode, native scalar,
-//! native batched on each SIMD level the CPU has, rapier (criterion).
-//! `psa-esp bench` measures the same in one run and prints a table.
+//! calls, PSA network evaluations on every path (ode, native scalar,
+//! native batched on each SIMD level the CPU has, rapier) and the logistic
+//! function alone as the batched path computes it (criterion); the
+//! 2-thread figures are in `threads.rs`. `psa-esp bench` measures the same
+//! in one run and prints a table.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use psa_esp::physics::{create_backend, BackendKind, BodyState, StepSettings};
@@ -111,5 +113,20 @@ fn psa_evaluation(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, physics_step, ode_path, psa_evaluation);
+/// The logistic function over blocks of the batched path's width, on the
+/// CPU's best SIMD level; reported per value.
+fn logistic_function(c: &mut Criterion) {
+    use psa_esp::cli::bench::{logistic_arguments, logistic_rounds};
+    use psa_esp::psa::batch::LANES;
+    const BLOCKS: usize = 64;
+    let mut values = logistic_arguments(BLOCKS);
+    let mut group = c.benchmark_group("logistic_function");
+    group.throughput(criterion::Throughput::Elements((BLOCKS * LANES) as u64));
+    group.bench_function(format!("{BLOCKS} blocks of {LANES} values"), |b| {
+        b.iter(|| logistic_rounds(std::hint::black_box(&mut values), 1))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, physics_step, ode_path, psa_evaluation, logistic_function);
 criterion_main!(benches);

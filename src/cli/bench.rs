@@ -12,7 +12,7 @@ use anyhow::Result;
 use multiversion::multiversion;
 use serde::Serialize;
 
-use super::bench_runs::{algorithm_overhead, evolve_scaling, replicate_scaling};
+use super::bench_runs::{algorithm_overhead, evolve_workload, replicate_workload};
 use crate::evolution::evaluate_all;
 use crate::evolution::operators::random_genes;
 use crate::experiment::PsaEvaluator;
@@ -49,14 +49,16 @@ pub struct BenchArgs {
 /// A way of evaluating networks: a backend, and on `native` the scalar
 /// reference or the batched path on one SIMD level.
 #[derive(Debug, Clone, Copy, Serialize)]
-struct EvaluationPath {
-    backend: BackendKind,
+pub struct EvaluationPath {
+    /// The physics backend.
+    pub backend: BackendKind,
     /// The batched path's SIMD level; `None` for the scalar path.
-    simd: Option<SimdLevel>,
+    pub simd: Option<SimdLevel>,
 }
 
 impl EvaluationPath {
-    fn label(&self) -> String {
+    /// The path's name in the bench's table.
+    pub fn label(&self) -> String {
         match (self.backend, self.simd) {
             (BackendKind::Native, None) => "native scalar".into(),
             (BackendKind::Native, Some(level)) => format!("native batched {level}"),
@@ -65,7 +67,7 @@ impl EvaluationPath {
     }
 
     /// ode, native scalar, native batched on every level the CPU has, rapier.
-    fn all() -> Vec<EvaluationPath> {
+    pub fn all() -> Vec<EvaluationPath> {
         let mut paths = Vec::new();
         for backend in BackendKind::available() {
             paths.push(EvaluationPath { backend, simd: None });
@@ -83,6 +85,15 @@ impl EvaluationPath {
         }
         paths
     }
+
+    /// The evaluator of the benchmark's task (task 1, default settings) on this path.
+    pub fn evaluator(&self) -> Result<PsaEvaluator> {
+        let settings = PsaSettings {
+            backend: self.backend,
+            ..PsaSettings::default()
+        };
+        Ok(PsaEvaluator::new(settings, Task::StopRotation)?.with_batching(self.simd))
+    }
 }
 
 /// One path's speed at whole network evaluations (one 500-step trial each).
@@ -95,8 +106,8 @@ struct EvaluationTiming {
     ns_per_network_step_1_thread: f64,
 }
 
-/// Random 7-[`HIDDEN`]-4 networks, weights uniform in (-6, 6) as ESP starts them.
-fn random_networks(count: u64) -> Result<Vec<Network>> {
+/// Random 7-5-4 networks, weights uniform in (-6, 6) as ESP starts them.
+pub fn random_networks(count: u64) -> Result<Vec<Network>> {
     let mut rng = crate::rng::stream(1, &[]);
     (0..count)
         .map(|_| {
@@ -112,11 +123,7 @@ fn random_networks(count: u64) -> Result<Vec<Network>> {
 /// Evaluations per second of `networks` on task 1 with `threads` threads
 /// (median of `rounds` rounds).
 fn evaluations_per_second(path: EvaluationPath, networks: &[Network], threads: usize, rounds: u64) -> Result<f64> {
-    let settings = PsaSettings {
-        backend: path.backend,
-        ..PsaSettings::default()
-    };
-    let evaluator = PsaEvaluator::new(settings, Task::StopRotation)?.with_batching(path.simd);
+    let evaluator = path.evaluator()?;
     let pool = crate::ode::thread_pool(threads)?;
     let mut rates = Vec::new();
     for round in 0..rounds {
@@ -139,9 +146,10 @@ struct LogisticTiming {
     percent_of_batched_network_step: f64,
 }
 
-/// Applies the logistic function `rounds` times over to every value.
+/// Applies the logistic function `rounds` times over to every value, on the
+/// CPU's best SIMD level.
 #[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl", "x86_64+avx2+fma"))]
-fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
+pub fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
     for _ in 0..rounds {
         for v in values.iter_mut() {
             *v = sigmoid(*v);
@@ -149,14 +157,20 @@ fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
     }
 }
 
+/// `blocks` blocks of arguments for [`logistic_rounds`], spread over [-4, 4]
+/// (where the function's result is far from 0 and 1).
+pub fn logistic_arguments(blocks: usize) -> Vec<Lanes<LANES>> {
+    (0..blocks)
+        .map(|b| Lanes(std::array::from_fn(|l| ((b * LANES + l) % 97) as f64 / 12.0 - 4.0)))
+        .collect()
+}
+
 /// ns per value of the logistic function (median of `rounds` rounds of
 /// about 4 million values, which stay in the first-level cache).
 fn logistic_ns_per_value(rounds: u64) -> f64 {
     const BLOCKS: usize = 64;
     const REPEATS: usize = 2000;
-    let mut values: Vec<Lanes<LANES>> = (0..BLOCKS)
-        .map(|b| Lanes(std::array::from_fn(|l| ((b * LANES + l) % 97) as f64 / 12.0 - 4.0)))
-        .collect();
+    let mut values = logistic_arguments(BLOCKS);
     let mut samples: Vec<f64> = (0..rounds)
         .map(|_| {
             let start = Instant::now();
@@ -189,12 +203,21 @@ struct OdePathTiming {
 
 /// The machine the numbers were measured on.
 #[derive(Debug, Serialize)]
-struct Machine {
-    cpu: String,
-    cores: usize,
+pub struct Machine {
+    /// The CPU's model name (the architecture where it is not known).
+    pub cpu: String,
+    /// Cores (hardware threads) available to the process.
+    pub cores: usize,
 }
 
-fn machine() -> Machine {
+impl std::fmt::Display for Machine {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} ({} cores)", self.cpu, self.cores)
+    }
+}
+
+/// This machine.
+pub fn machine() -> Machine {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|info| {
@@ -297,8 +320,8 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             .map_or(f64::NAN, |ns| 100.0 * per_network_step as f64 * logistic_ns / ns),
     };
     let generations = args.generations as usize;
-    let evolve = evolve_scaling(generations, args.rounds)?;
-    let replicate = replicate_scaling(generations, args.rounds)?;
+    let evolve = evolve_workload(generations)?.scaling(args.rounds)?;
+    let replicate = replicate_workload(generations)?.scaling(args.rounds)?;
     // Long enough that the set-up before the first generation does not count.
     let overhead = algorithm_overhead(5 * generations, args.rounds)?;
     let machine = machine();
@@ -319,12 +342,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         });
         say!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        say!(
-            "machine: {} ({} cores); batched path runs on {}",
-            machine.cpu,
-            machine.cores,
-            SimdLevel::detect()
-        );
+        say!("machine: {machine}; batched path runs on {}", SimdLevel::detect());
         say!(
             "physics step, PSA body, dt {} s ({} rounds x {} steps, median):",
             settings.dt,

@@ -46,24 +46,40 @@ fn median(mut values: Vec<f64>) -> f64 {
     values[values.len() / 2]
 }
 
-/// Times `work(threads)` on 1 and 2 threads, interleaved, `rounds` times each.
-fn scaling(description: String, rounds: u64, work: impl Fn(usize) -> Result<()>) -> Result<RunScaling> {
-    let (mut one, mut two) = (Vec::new(), Vec::new());
-    for _ in 0..rounds {
-        for (threads, samples) in [(1, &mut one), (2, &mut two)] {
-            let clock = Instant::now();
-            work(threads)?;
-            samples.push(clock.elapsed().as_secs_f64());
-        }
+/// A whole-run workload that runs on any number of threads.
+pub struct Workload {
+    /// Its short name: the command it stands for.
+    pub name: &'static str,
+    /// What is run.
+    pub description: String,
+    work: Box<dyn Fn(usize) -> Result<()>>,
+}
+
+impl Workload {
+    /// Runs it once on `threads` threads.
+    pub fn run(&self, threads: usize) -> Result<()> {
+        (self.work)(threads)
     }
-    let (seconds_1_thread, seconds_2_threads) = (median(one), median(two));
-    Ok(RunScaling {
-        description,
-        seconds_1_thread,
-        seconds_2_threads,
-        speedup: seconds_1_thread / seconds_2_threads,
-        rounds,
-    })
+
+    /// Times it on 1 and 2 threads, interleaved, `rounds` times each.
+    pub fn scaling(&self, rounds: u64) -> Result<RunScaling> {
+        let (mut one, mut two) = (Vec::new(), Vec::new());
+        for _ in 0..rounds {
+            for (threads, samples) in [(1, &mut one), (2, &mut two)] {
+                let clock = Instant::now();
+                self.run(threads)?;
+                samples.push(clock.elapsed().as_secs_f64());
+            }
+        }
+        let (seconds_1_thread, seconds_2_threads) = (median(one), median(two));
+        Ok(RunScaling {
+            description: self.description.clone(),
+            seconds_1_thread,
+            seconds_2_threads,
+            speedup: seconds_1_thread / seconds_2_threads,
+            rounds,
+        })
+    }
 }
 
 /// The baseline ESP configuration on `native`, cut to `generations`.
@@ -75,18 +91,18 @@ fn baseline(generations: usize) -> Result<RunConfig> {
 }
 
 /// One baseline ESP run of task 3 on the default (batched) native path.
-pub fn evolve_scaling(generations: usize, rounds: u64) -> Result<RunScaling> {
+pub fn evolve_workload(generations: usize) -> Result<Workload> {
     let config = baseline(generations)?;
     let evaluator = PsaEvaluator::new(config.problem.clone(), Task::StopAtPosition)?;
     let esp = Esp::new(config.esp.clone(), 1).map_err(anyhow::Error::msg)?;
-    scaling(
-        format!("one baseline ESP run, task 3, native, {generations} generations"),
-        rounds,
-        |threads| {
+    Ok(Workload {
+        name: "evolve",
+        description: format!("one baseline ESP run, task 3, native, {generations} generations"),
+        work: Box::new(move |threads| {
             crate::ode::thread_pool(threads)?.install(|| esp.run(&evaluator, |_| {}))?;
             Ok(())
-        },
-    )
+        }),
+    })
 }
 
 struct Silent;
@@ -97,7 +113,7 @@ impl GridProgress for Silent {
 
 /// A small grid (baseline and max-credit, 3 tasks, 2 seeds, 50-trial
 /// robustness tests) replicated into a fresh temporary folder.
-pub fn replicate_scaling(generations: usize, rounds: u64) -> Result<RunScaling> {
+pub fn replicate_workload(generations: usize) -> Result<Workload> {
     let spec = GridSpec {
         configs: vec![
             GridConfig::Preset(Preset::Baseline),
@@ -110,15 +126,17 @@ pub fn replicate_scaling(generations: usize, rounds: u64) -> Result<RunScaling> 
         ..GridSpec::from_preset(GridPreset::Quick)
     };
     let runs = spec.runs().len();
-    scaling(
-        format!("replicate of {runs} runs (2 configurations x 3 tasks x 2 seeds), native, {generations} generations"),
-        rounds,
-        |threads| {
+    Ok(Workload {
+        name: "replicate",
+        description: format!(
+            "replicate of {runs} runs (2 configurations x 3 tasks x 2 seeds), native, {generations} generations"
+        ),
+        work: Box::new(move |threads| {
             let dir = tempfile::Builder::new().prefix("psa-esp-bench-").tempdir()?;
             replicate(dir.path(), &spec, threads, &Silent)?;
             Ok(())
-        },
-    )
+        }),
+    })
 }
 
 /// An evaluator that adds the wall time spent evaluating to a counter.

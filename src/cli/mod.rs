@@ -8,8 +8,8 @@ macro_rules! say {
     };
 }
 
-mod bench;
-mod bench_runs;
+pub mod bench;
+pub mod bench_runs;
 mod crosscheck;
 mod evolve;
 mod replay;
