@@ -6,8 +6,16 @@
 //! 1. `ode-sys` (a separate crate): raw bindgen bindings to libode;
 //! 2. [`ode`]: the safe ODE wrapper (all of the project's other `unsafe`);
 //! 3. [`physics`]: the backends `ode`, `native` and `rapier` behind one trait;
-//! 4. [`psa`]: the robot, its thrusters and (later) its tasks;
-//! 5. [`provenance`] and the command-line tools in [`cli`].
+//! 4. [`psa`]: the robot, its thrusters, sensors, noise, tasks and fitness,
+//!    and the batched evaluation path;
+//! 5. [`evolution`]: ESP and the hill-climber, generic over any evaluation
+//!    function;
+//! 6. [`experiment`]: run configurations, the experiment grid, robustness
+//!    tests, statistics and the report (with [`plots`]);
+//! 7. [`cli`]: the command line, including `bench`.
+//!
+//! Beside the layers: [`numeric`] (the shared per-step arithmetic and SIMD
+//! lanes), [`network`], [`rng`], [`io`] (atomic writes) and [`provenance`].
 
 pub mod cli;
 pub mod evolution;

@@ -1,7 +1,7 @@
 //! Search algorithms over networks: Enforced Sub-Populations (ESP) with every
 //! modification of Høverstad (2007) as a switch, and his hill-climber.
 //!
-//! Both are generic: they search [`Network`]s against any [`Evaluator`] and
+//! Both are generic: they search [`Network`](crate::network::Network)s against any [`Evaluator`] and
 //! know nothing of the PSA. Network evaluations run in parallel on rayon;
 //! every random draw comes from a stream keyed by what it is for (seed,
 //! generation, network, ...), so a run is bit-identical for any thread count.

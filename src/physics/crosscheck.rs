@@ -89,7 +89,7 @@ pub struct BackendComparison {
     /// The backend compared against `ode`.
     pub backend: BackendKind,
     /// What it is held to: `ode` itself, or (rapier) ODE's model with the
-    /// backend's own rotation rule; see [`RAPIER_TOLERANCE`].
+    /// backend's own rotation rule; see `RAPIER_TOLERANCE`.
     pub reference: &'static str,
     /// Its largest differences from the reference.
     pub deviation: Deviation,
