@@ -1,8 +1,8 @@
 //! 1 against 2 threads (criterion): PSA network evaluations on every path
 //! (ode, native scalar, native batched on each SIMD level the CPU has,
 //! rapier); `evolve`, one baseline ESP run of task 3 on `native`; and
-//! `replicate`, a grid of 12 such runs (baseline and max-credit, 3 tasks,
-//! 2 seeds) with its robustness tests. The speed-up is the ratio of a
+//! `replicate`, a grid of 12 runs on `native` (baseline and max-credit, 3
+//! tasks, 2 seeds) with 50-trial robustness tests. The speed-up is the ratio of a
 //! workload's two times. `psa-esp bench` measures the same in one run and
 //! prints it, with the machine.
 

@@ -157,8 +157,8 @@ pub fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
     }
 }
 
-/// `blocks` blocks of arguments for [`logistic_rounds`], spread over [-4, 4]
-/// (where the function's result is far from 0 and 1).
+/// `blocks` blocks of arguments for [`logistic_rounds`], spread over [-4, 4],
+/// where the function is not saturated.
 pub fn logistic_arguments(blocks: usize) -> Vec<Lanes<LANES>> {
     (0..blocks)
         .map(|b| Lanes(std::array::from_fn(|l| ((b * LANES + l) % 97) as f64 / 12.0 - 4.0)))

@@ -12,7 +12,7 @@ use super::{exponent_of, mantissa_of, unit_from_bits, Real, TWO_52};
 /// Aligned to 64 bytes, a cache line, like the other lane types: a SIMD
 /// load or store of eight lanes then never straddles two lines, wherever
 /// the stack or the heap puts the value. Without it the batched kernels,
-/// which keep much of their state in memory, ran up to a third slower
+/// which keep much of their state in memory, ran up to 40 % slower
 /// depending on the call path and on the allocator (see the README's
 /// Performance section).
 #[derive(Debug, Clone, Copy, PartialEq)]
