@@ -116,13 +116,12 @@ fn psa_evaluation(c: &mut Criterion) {
 /// The logistic function over blocks of the batched path's width, on the
 /// CPU's best SIMD level; reported per value.
 fn logistic_function(c: &mut Criterion) {
-    use psa_esp::cli::bench::{logistic_arguments, logistic_rounds};
+    use psa_esp::cli::bench::{logistic_arguments, logistic_rounds, LOGISTIC_BLOCKS};
     use psa_esp::psa::batch::LANES;
-    const BLOCKS: usize = 64;
-    let mut values = logistic_arguments(BLOCKS);
+    let mut values = logistic_arguments(LOGISTIC_BLOCKS);
     let mut group = c.benchmark_group("logistic_function");
-    group.throughput(criterion::Throughput::Elements((BLOCKS * LANES) as u64));
-    group.bench_function(format!("{BLOCKS} blocks of {LANES} values"), |b| {
+    group.throughput(criterion::Throughput::Elements((LOGISTIC_BLOCKS * LANES) as u64));
+    group.bench_function(format!("{LOGISTIC_BLOCKS} blocks of {LANES} values"), |b| {
         b.iter(|| logistic_rounds(std::hint::black_box(&mut values), 1))
     });
     group.finish();

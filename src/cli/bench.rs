@@ -12,7 +12,7 @@ use anyhow::Result;
 use multiversion::multiversion;
 use serde::Serialize;
 
-use super::bench_runs::{algorithm_overhead, evolve_workload, replicate_workload};
+use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
 use crate::evolution::evaluate_all;
 use crate::evolution::operators::random_genes;
 use crate::experiment::PsaEvaluator;
@@ -131,8 +131,7 @@ fn evaluations_per_second(path: EvaluationPath, networks: &[Network], threads: u
         pool.install(|| evaluate_all(&evaluator, networks, round, &[]))?;
         rates.push(networks.len() as f64 / start.elapsed().as_secs_f64());
     }
-    rates.sort_by(f64::total_cmp);
-    Ok(rates[rates.len() / 2])
+    Ok(median(rates))
 }
 
 /// The logistic function alone, as the batched path computes it: blocks of
@@ -157,6 +156,10 @@ pub fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
     }
 }
 
+/// Blocks of [`LANES`] values in the logistic function's benchmark (16 KiB,
+/// which stay in the first-level cache).
+pub const LOGISTIC_BLOCKS: usize = 64;
+
 /// `blocks` blocks of arguments for [`logistic_rounds`], spread over [-4, 4],
 /// where the function is not saturated.
 pub fn logistic_arguments(blocks: usize) -> Vec<Lanes<LANES>> {
@@ -168,19 +171,17 @@ pub fn logistic_arguments(blocks: usize) -> Vec<Lanes<LANES>> {
 /// ns per value of the logistic function (median of `rounds` rounds of
 /// about 4 million values, which stay in the first-level cache).
 fn logistic_ns_per_value(rounds: u64) -> f64 {
-    const BLOCKS: usize = 64;
     const REPEATS: usize = 2000;
-    let mut values = logistic_arguments(BLOCKS);
-    let mut samples: Vec<f64> = (0..rounds)
+    let mut values = logistic_arguments(LOGISTIC_BLOCKS);
+    let samples: Vec<f64> = (0..rounds)
         .map(|_| {
             let start = Instant::now();
             logistic_rounds(std::hint::black_box(&mut values), REPEATS);
-            start.elapsed().as_nanos() as f64 / (BLOCKS * LANES * REPEATS) as f64
+            start.elapsed().as_nanos() as f64 / (LOGISTIC_BLOCKS * LANES * REPEATS) as f64
         })
         .collect();
     std::hint::black_box(&values);
-    samples.sort_by(f64::total_cmp);
-    samples[samples.len() / 2]
+    median(samples)
 }
 
 /// One backend's timing.
@@ -261,11 +262,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             samples.push(time_steps(backend.as_mut(), &commands, args.steps)?);
         }
     }
-    let median = |s: &mut Vec<f64>| {
-        s.sort_by(f64::total_cmp);
-        s[s.len() / 2]
-    };
-    let medians: Vec<f64> = samples.iter_mut().map(median).collect();
+    let medians: Vec<f64> = samples.iter().map(|s| median(s.clone())).collect();
     let ode = medians[0];
     let timings: Vec<StepTiming> = kinds
         .iter()
@@ -274,7 +271,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         .map(|((&backend, s), &m)| StepTiming {
             backend,
             median_ns_per_step: m,
-            min_ns_per_step: s[0],
+            min_ns_per_step: s.iter().copied().fold(f64::INFINITY, f64::min),
             relative_to_ode: m / ode,
         })
         .collect();

@@ -41,7 +41,8 @@ pub struct AlgorithmOverhead {
     pub percent: f64,
 }
 
-fn median(mut values: Vec<f64>) -> f64 {
+/// The median of the bench's samples (the upper one of an even count).
+pub(super) fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
     values[values.len() / 2]
 }
