@@ -33,6 +33,17 @@ pub fn sigmoid(x: f64) -> f64 {
     crate::numeric::sigmoid(x)
 }
 
+/// The index of the first non-finite weight, if any. Checks all weights in
+/// one pass without early exit, which the compiler vectorises: ESP copies
+/// every neuron into a network each generation, so this check runs
+/// thousands of times per generation.
+fn first_non_finite(genes: &[f64]) -> Option<usize> {
+    if genes.iter().fold(true, |finite, v| finite & v.is_finite()) {
+        return None;
+    }
+    genes.iter().position(|v| !v.is_finite())
+}
+
 fn check_sizes(inputs: usize, outputs: usize) -> Result<(), NetworkError> {
     if inputs == 0 || outputs == 0 {
         return Err(NetworkError::Shape(format!(
@@ -75,11 +86,11 @@ impl Network {
                 genes.len()
             )));
         }
-        if let Some((i, &value)) = genes.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        if let Some(i) = first_non_finite(&genes) {
             return Err(NetworkError::NonFinite {
                 neuron: i / per,
                 index: i % per,
-                value,
+                value: genes[i],
             });
         }
         let hidden = genes.len() / per;
@@ -136,11 +147,11 @@ impl Network {
                 genes.len()
             )));
         }
-        if let Some((index, &value)) = genes.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        if let Some(index) = first_non_finite(genes) {
             return Err(NetworkError::NonFinite {
                 neuron: k,
                 index,
-                value,
+                value: genes[index],
             });
         }
         self.genes[k * per..(k + 1) * per].copy_from_slice(genes);
@@ -232,6 +243,8 @@ mod tests {
         assert!(!net.is_lesioned(1));
         assert!(net.set_neuron(0, &[1.0, 2.0]).is_err());
         assert!(net.set_neuron(0, &[1.0, f64::NAN, 2.0]).is_err());
+        let err = net.set_neuron(0, &[1.0, 2.0, f64::NEG_INFINITY]).unwrap_err();
+        assert_eq!(err.to_string(), "weight 2 of hidden neuron 0 is not finite (-inf)");
         assert_eq!(net.neuron(0), &[1.0, -1.0, 2.0]);
     }
 
