@@ -45,7 +45,7 @@ pub struct SimulateArgs {
     pub physics: PhysicsArgs,
 }
 
-/// The default number of steps of a trial ([chosen] 500 x 0.05 s = 25 s).
+/// The default number of steps of a trial (`[chosen]` 500 x 0.05 s = 25 s).
 const DEFAULT_STEPS: usize = 500;
 
 fn read_thrust_file(path: &PathBuf) -> Result<Vec<Vec<f64>>> {

@@ -51,7 +51,7 @@ pub enum BurstMode {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TopologyMode {
-    /// Lesion tests add or remove sub-populations. [paper]
+    /// Lesion tests add or remove sub-populations. `[paper]`
     Lesion,
     /// No lesion tests, no topology change. (Table 6)
     Off,
@@ -61,39 +61,39 @@ pub enum TopologyMode {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EspSettings {
-    /// Neurons per sub-population. [paper] 40
+    /// Neurons per sub-population. `[paper]` 40
     pub subpop_size: usize,
-    /// Networks per generation = this x `subpop_size`. [paper] 10
+    /// Networks per generation = this x `subpop_size`. `[paper]` 10
     pub trials_per_neuron: usize,
-    /// Sub-populations (hidden neurons) at the start. [paper] 5
+    /// Sub-populations (hidden neurons) at the start. `[paper]` 5
     pub initial_hidden: usize,
-    /// Generations. [paper] 2000
+    /// Generations. `[paper]` 2000
     pub generations: usize,
-    /// Initial weights are uniform in (-range, range). [paper] 6
+    /// Initial weights are uniform in (-range, range). `[paper]` 6
     pub init_range: f64,
-    /// Network formation. [paper] random
+    /// Network formation. `[paper]` random
     pub sampling: Sampling,
-    /// Neuron credit. [paper] mean
+    /// Neuron credit. `[paper]` mean
     pub credit: Credit,
-    /// Probability that a child gets Cauchy noise on one gene. [paper] 0.4
+    /// Probability that a child gets Cauchy noise on one gene. `[paper]` 0.4
     pub mutation_rate: f64,
-    /// Scale of that Cauchy noise. [paper] 0.3
+    /// Scale of that Cauchy noise. `[paper]` 0.3
     pub mutation_scale: f64,
-    /// Cauchy draws larger than this in magnitude are drawn again. [paper] 10
+    /// Cauchy draws larger than this in magnitude are drawn again. `[paper]` 10
     pub cauchy_limit: f64,
-    /// Generations without improvement of the best network before a burst mutation (b). [paper] 20
+    /// Generations without improvement of the best network before a burst mutation (b). `[paper]` 20
     pub stagnation: usize,
-    /// Scale of the Cauchy noise of burst mutation, on every gene. [paper] 0.3
+    /// Scale of the Cauchy noise of burst mutation, on every gene. `[paper]` 0.3
     pub burst_scale: f64,
     /// Burst mutation's form. [paper, Høverstad] discard_all
     pub burst: BurstMode,
-    /// Lesion tests after `bursts_before_lesion` fruitless burst mutations. [paper] lesion
+    /// Lesion tests after `bursts_before_lesion` fruitless burst mutations. `[paper]` lesion
     pub topology: TopologyMode,
-    /// Burst mutations without improvement that trigger a lesion test. [paper] 2
+    /// Burst mutations without improvement that trigger a lesion test. `[paper]` 2
     pub bursts_before_lesion: usize,
-    /// A neuron is redundant when the network without it keeps this share of the fitness. [chosen] 0.9
+    /// A neuron is redundant when the network without it keeps this share of the fitness. `[chosen]` 0.9
     pub lesion_threshold: f64,
-    /// Forget the search's best network whenever a sub-population is added or removed. (Table 6) [paper] false
+    /// Forget the search's best network whenever a sub-population is added or removed. (Table 6) `[paper]` false
     pub erase_best: bool,
 }
 

@@ -10,33 +10,33 @@ use super::{Champion, Evaluator, GenerationRecord, RunResult};
 use crate::network::Network;
 use crate::rng::{stream, Stream};
 
-/// Every setting of the hill-climber ([chosen] defaults give it ESP's budget).
+/// Every setting of the hill-climber (`[chosen]` defaults give it ESP's budget).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct HillClimbSettings {
-    /// Hidden neurons of the network. [chosen] 5
+    /// Hidden neurons of the network. `[chosen]` 5
     pub hidden: usize,
-    /// Candidates per cycle (K). [chosen] 400
+    /// Candidates per cycle (K). `[chosen]` 400
     pub candidates: usize,
-    /// Cycles. [chosen] 2000
+    /// Cycles. `[chosen]` 2000
     pub cycles: usize,
-    /// Initial weights are uniform in (-range, range). [paper] 6
+    /// Initial weights are uniform in (-range, range). `[paper]` 6
     pub init_range: f64,
-    /// Probability that a weight gets Cauchy noise. [chosen] 0.2
+    /// Probability that a weight gets Cauchy noise. `[chosen]` 0.2
     pub p_noise: f64,
-    /// Scale of that noise (alpha). [chosen] 1.0
+    /// Scale of that noise (alpha). `[chosen]` 1.0
     pub alpha: f64,
-    /// Probability that a weight then changes sign. [chosen] 0.05
+    /// Probability that a weight then changes sign. `[chosen]` 0.05
     pub p_flip: f64,
-    /// p_noise is multiplied by this after every cycle. [chosen] 0.999
+    /// p_noise is multiplied by this after every cycle. `[chosen]` 0.999
     pub anneal_noise: f64,
-    /// alpha is multiplied by this after every cycle. [chosen] 0.999
+    /// alpha is multiplied by this after every cycle. `[chosen]` 0.999
     pub anneal_alpha: f64,
-    /// p_flip is multiplied by this after every cycle. [chosen] 0.999
+    /// p_flip is multiplied by this after every cycle. `[chosen]` 0.999
     pub anneal_flip: f64,
-    /// Keep the base unless a candidate is at least as good (reported worse). [paper] false
+    /// Keep the base unless a candidate is at least as good (reported worse). `[paper]` false
     pub elitist: bool,
-    /// Cauchy draws larger than this in magnitude are drawn again. [chosen] 10, as ESP
+    /// Cauchy draws larger than this in magnitude are drawn again. `[chosen]` 10, as ESP
     pub cauchy_limit: f64,
 }
 

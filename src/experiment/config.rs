@@ -207,9 +207,9 @@ pub enum GridConfig {
     RandomInit,
 }
 
-/// Input noise of Table 3's evolution and of the robustness tests. [paper] 0.05
+/// Input noise of Table 3's evolution and of the robustness tests. `[paper]` 0.05
 pub const PAPER_NOISE_SD: f64 = 0.05;
-/// Trials per evaluation under noise or random initialisation. [paper] 3
+/// Trials per evaluation under noise or random initialisation. `[paper]` 3
 pub const PAPER_NOISY_TRIALS: usize = 3;
 
 impl GridConfig {

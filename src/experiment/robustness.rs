@@ -40,7 +40,7 @@ impl TrialSummary {
 pub struct Robustness {
     /// Trials of each test.
     pub trials: usize,
-    /// The input noise of the noise test (sd). [paper] 0.05
+    /// The input noise of the noise test (sd). `[paper]` 0.05
     pub input_noise_sd: f64,
     /// The champion flown once without noise from the task's standard start.
     pub clean: f64,

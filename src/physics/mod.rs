@@ -111,26 +111,26 @@ pub enum PlaneConstraint {
     Plane2dJoint,
 }
 
-/// Simulation settings shared by every backend ([chosen] values, spec §1).
+/// Simulation settings shared by every backend (`[chosen]` values, spec §1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct StepSettings {
-    /// Physics (and control) time step (s). [chosen] 0.05
+    /// Physics (and control) time step (s). `[chosen]` 0.05
     pub dt: f64,
-    /// ODE stepper. [chosen] exact
+    /// ODE stepper. `[chosen]` exact
     pub stepper: Stepper,
-    /// Iterations of ODE's QuickStep, when selected. [chosen] 20
+    /// Iterations of ODE's QuickStep, when selected. `[chosen]` 20
     pub quick_step_iterations: u32,
-    /// How ODE keeps the body in the plane. [chosen] none (see [`PlaneConstraint`])
+    /// How ODE keeps the body in the plane. `[chosen]` none (see [`PlaneConstraint`])
     pub plane_constraint: PlaneConstraint,
     /// ODE's gyroscopic term. For a planar spin about a principal axis, as
     /// here, w x (I w) is exactly zero, and the explicit form of the ODE the
     /// paper used added exactly nothing; ODE 0.16's implicit form still
     /// rounds omega by an ulp now and then, enough to trip the fitness'
     /// "spin is slowing" test. Off reproduces the exact planar motion.
-    /// [chosen] false
+    /// `[chosen]` false
     pub ode_gyroscopic: bool,
-    /// Solver iterations (substeps) of rapier's integrator. [chosen] 1
+    /// Solver iterations (substeps) of rapier's integrator. `[chosen]` 1
     pub rapier_solver_iterations: u32,
 }
 

@@ -15,21 +15,21 @@ use crate::physics::{MassPart, PhysicsError, RigidBodyModel, Thruster};
 /// The number of thrusters (and of network outputs).
 pub const THRUSTER_COUNT: usize = 4;
 
-/// Geometry and mass of the PSA ([chosen] values of the spec unless marked).
+/// Geometry and mass of the PSA (`[chosen]` values of the spec unless marked).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct BodySettings {
-    /// Radius of the round hull, a solid cylinder along z (m). [chosen] 0.10
+    /// Radius of the round hull, a solid cylinder along z (m). `[chosen]` 0.10
     pub hull_radius: f64,
-    /// Height of the hull along z (m). [chosen] 0.10
+    /// Height of the hull along z (m). `[chosen]` 0.10
     pub hull_height: f64,
-    /// Thruster box: length along its thrust axis, width, height (m). [chosen] 0.04 x 0.02 x 0.02
+    /// Thruster box: length along its thrust axis, width, height (m). `[chosen]` 0.04 x 0.02 x 0.02
     pub thruster_size: [f64; 3],
-    /// Distance of each thruster's centre (its mount) from the hull's centre (m). [chosen] 0.12
+    /// Distance of each thruster's centre (its mount) from the hull's centre (m). `[chosen]` 0.12
     pub mount_radius: f64,
-    /// Density of hull and thrusters alike (kg/m^3). [chosen] 1000
+    /// Density of hull and thrusters alike (kg/m^3). `[chosen]` 1000
     pub density: f64,
-    /// Force of a thruster at full output (N). [paper] 1
+    /// Force of a thruster at full output (N). `[paper]` 1
     pub max_force: f64,
 }
 

@@ -8,7 +8,7 @@ use crate::numeric::Real;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FitnessKind {
-    /// Høverstad's incremental fitness: 1 point for position and spin, 3 more for heading. [paper] default
+    /// Høverstad's incremental fitness: 1 point for position and spin, 3 more for heading. `[paper]` default
     Incremental,
     /// Sit's original fitness: 1 point for position and heading together.
     Original,
@@ -18,17 +18,17 @@ pub enum FitnessKind {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FitnessSettings {
-    /// Which function. [paper] incremental
+    /// Which function. `[paper]` incremental
     pub kind: FitnessKind,
-    /// Half-width of the target box: |x|, |y| below it (m). [paper] 0.2
+    /// Half-width of the target box: |x|, |y| below it (m). `[paper]` 0.2
     pub box_half_width: f64,
-    /// Heading window: |heading error| below it (rad). [paper] 0.05
+    /// Heading window: |heading error| below it (rad). `[paper]` 0.05
     pub heading_window: f64,
-    /// Spin window: |omega| below it (rad/s). [paper] 0.05
+    /// Spin window: |omega| below it (rad/s). `[paper]` 0.05
     pub spin_window: f64,
-    /// Points for being in the box with the spin under control. [paper] 1
+    /// Points for being in the box with the spin under control. `[paper]` 1
     pub position_points: f64,
-    /// Extra points for also being on heading. [paper] 3
+    /// Extra points for also being on heading. `[paper]` 3
     pub heading_points: f64,
 }
 

@@ -12,19 +12,19 @@ use crate::physics::{wrap_angle, BodyState};
 /// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
 pub const INPUT_COUNT: usize = 7;
 
-/// Input scaling ([chosen] values; the paper's inputs were O(1) or larger).
+/// Input scaling (`[chosen]` values; the paper's inputs were O(1) or larger).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSettings {
-    /// Input units per metre of position relative to the target. [chosen] 10
+    /// Input units per metre of position relative to the target. `[chosen]` 10
     pub position_scale: f64,
-    /// Input units per m/s of velocity. [chosen] 10
+    /// Input units per m/s of velocity. `[chosen]` 10
     pub velocity_scale: f64,
-    /// Input units per radian of heading error. [chosen] 1
+    /// Input units per radian of heading error. `[chosen]` 1
     pub heading_scale: f64,
-    /// Input units per rad/s of angular velocity. [chosen] 1
+    /// Input units per rad/s of angular velocity. `[chosen]` 1
     pub angular_velocity_scale: f64,
-    /// The constant bias input. [chosen] 1
+    /// The constant bias input. `[chosen]` 1
     pub bias: f64,
 }
 
@@ -96,9 +96,9 @@ impl SensorSettings {
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseSettings {
-    /// Standard deviation of the noise on every input but the bias. [paper] 0 (0.05 in robustness tests)
+    /// Standard deviation of the noise on every input but the bias. `[paper]` 0 (0.05 in robustness tests)
     pub input_sd: f64,
-    /// Standard deviation of the noise on every output, before clamping to [0, 1]. [paper] 0
+    /// Standard deviation of the noise on every output, before clamping to [0, 1]. `[paper]` 0
     pub output_sd: f64,
 }
 

@@ -82,21 +82,21 @@ pub struct Target {
     pub heading: f64,
 }
 
-/// The tasks' [chosen] constants.
+/// The tasks' `[chosen]` constants.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TaskSettings {
-    /// Task 1: initial spin (rad/s). [chosen] 1.0
+    /// Task 1: initial spin (rad/s). `[chosen]` 1.0
     pub task1_spin: f64,
-    /// Task 2: target heading (rad, anticlockwise). [chosen] pi/2
+    /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
-    /// Task 3: initial forward (+y) speed (m/s). [chosen] 0.1
+    /// Task 3: initial forward (+y) speed (m/s). `[chosen]` 0.1
     pub task3_speed: f64,
-    /// Task 3: distance of the target along +y (m). [chosen] 0.40
+    /// Task 3: distance of the target along +y (m). `[chosen]` 0.40
     pub task3_distance: f64,
-    /// Task 3: target heading (rad): turned round. [chosen] pi
+    /// Task 3: target heading (rad): turned round. `[chosen]` pi
     pub task3_target_heading: f64,
-    /// Task 3, random initialisation: target distance range (m). [paper] [0.25, 0.55]
+    /// Task 3, random initialisation: target distance range (m). `[paper]` [0.25, 0.55]
     pub task3_random_distance: [f64; 2],
 }
 

@@ -28,18 +28,18 @@ pub enum PsaError {
     Physics(#[from] PhysicsError),
 }
 
-/// Everything that defines the PSA control problem; every [chosen] value of
+/// Everything that defines the PSA control problem; every `[chosen]` value of
 /// the spec is one of these settings, recorded in every result file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PsaSettings {
-    /// Physics backend. [chosen] ode
+    /// Physics backend. `[chosen]` ode
     pub backend: BackendKind,
-    /// Steps per trial. [chosen] 500 (25 s at dt 0.05 s)
+    /// Steps per trial. `[chosen]` 500 (25 s at dt 0.05 s)
     pub steps: usize,
-    /// Trials per evaluation; the fitness is their mean. [paper] 1, 3 under noise or random initialisation
+    /// Trials per evaluation; the fitness is their mean. `[paper]` 1, 3 under noise or random initialisation
     pub trials: usize,
-    /// Random initial conditions (tasks 1 and 3). [paper] false
+    /// Random initial conditions (tasks 1 and 3). `[paper]` false
     pub random_init: bool,
     /// The body.
     pub body: BodySettings,
