@@ -16,7 +16,7 @@ use crate::rng::stream;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Sampling {
-    /// Each network takes a uniformly random neuron from every sub-population. [paper, ESP]
+    /// Each network takes a uniformly random neuron from every sub-population. `[paper, ESP]`
     Random,
     /// Høverstad's: per round, shuffle every sub-population and build network
     /// k from the k-th neurons; every neuron is evaluated exactly
@@ -28,7 +28,7 @@ pub enum Sampling {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Credit {
-    /// The mean fitness of the networks it took part in. [paper, ESP]
+    /// The mean fitness of the networks it took part in. `[paper, ESP]`
     Mean,
     /// The highest. (Table 5)
     Max,
@@ -85,7 +85,7 @@ pub struct EspSettings {
     pub stagnation: usize,
     /// Scale of the Cauchy noise of burst mutation, on every gene. `[paper]` 0.3
     pub burst_scale: f64,
-    /// Burst mutation's form. [paper, Høverstad] discard_all
+    /// Burst mutation's form. `[paper, Høverstad]` discard_all
     pub burst: BurstMode,
     /// Lesion tests after `bursts_before_lesion` fruitless burst mutations. `[paper]` lesion
     pub topology: TopologyMode,

@@ -92,7 +92,7 @@ pub fn wrap_angle(angle: f64) -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Stepper {
-    /// `dWorldStep`, the exact (direct LCP) stepper. [chosen, spec]
+    /// `dWorldStep`, the exact (direct LCP) stepper. `[chosen, spec]`
     Exact,
     /// `dWorldQuickStep`, the iterative stepper.
     Quick,
