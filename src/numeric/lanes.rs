@@ -5,7 +5,7 @@
 
 use std::ops::{Add, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Not, Sub};
 
-use super::{exponent_of, mantissa_of, unit_from_bits, Real, TWO_52};
+use super::{exp2_int_of, exponent_of, mantissa_of, unit_from_bits, Real};
 
 /// N `f64` values, one per lane.
 ///
@@ -175,9 +175,7 @@ impl<const N: usize> Real for Lanes<N> {
     }
     #[inline(always)]
     fn exp2_int(k: Self) -> Self {
-        // k + 2^52 holds k (as an integer) in its low mantissa bits.
-        let shifted = (k + Self::splat(TWO_52 + 1023.0)).bits();
-        Self::from_bits(from_fn(|i| (shifted[i] - TWO_52.to_bits()) << 52))
+        Lanes(from_fn(|i| exp2_int_of(k.0[i])))
     }
     #[inline(always)]
     fn all(mask: LaneMask<N>) -> bool {

@@ -100,6 +100,16 @@ fn exponent_of(x: f64) -> f64 {
     biased - (TWO_52 + 1023.0)
 }
 
+/// [`Real::exp2_int`] of one integral `k` in [-1022, 1023]: `k + 2^52`
+/// holds k + 1023 in its low mantissa bits, which become the exponent
+/// field (integer operations and one exact addition, so it vectorises on
+/// every level, and the scalar path needs no float-to-integer conversion).
+#[inline(always)]
+fn exp2_int_of(k: f64) -> f64 {
+    let shifted = (k + (TWO_52 + 1023.0)).to_bits();
+    f64::from_bits((shifted - TWO_52.to_bits()) << 52)
+}
+
 impl Real for f64 {
     type Mask = bool;
     #[inline(always)]
@@ -140,7 +150,7 @@ impl Real for f64 {
     }
     #[inline(always)]
     fn exp2_int(k: f64) -> f64 {
-        f64::from_bits(((k as i64 + 1023) as u64) << 52)
+        exp2_int_of(k)
     }
     #[inline(always)]
     fn all(mask: bool) -> bool {
