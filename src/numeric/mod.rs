@@ -100,14 +100,16 @@ fn exponent_of(x: f64) -> f64 {
     biased - (TWO_52 + 1023.0)
 }
 
-/// [`Real::exp2_int`] of one integral `k` in [-1022, 1023]: `k + 2^52`
-/// holds k + 1023 in its low mantissa bits, which become the exponent
-/// field (integer operations and one exact addition, so it vectorises on
-/// every level, and the scalar path needs no float-to-integer conversion).
+/// [`Real::exp2_int`] of one integral `k` in [-1022, 1023]: the exact sum
+/// `k + 1023 + 2^52` holds k + 1023 in its low mantissa bits, which become
+/// the exponent field (one addition and integer operations, so it
+/// vectorises on every level, and the scalar path needs no float-to-integer
+/// conversion). Outside that range (a NaN from `exp`'s argument) the bits
+/// wrap and the result is meaningless, never a panic.
 #[inline(always)]
 fn exp2_int_of(k: f64) -> f64 {
     let shifted = (k + (TWO_52 + 1023.0)).to_bits();
-    f64::from_bits((shifted - TWO_52.to_bits()) << 52)
+    f64::from_bits(shifted.wrapping_sub(TWO_52.to_bits()) << 52)
 }
 
 impl Real for f64 {
