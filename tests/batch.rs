@@ -146,23 +146,27 @@ fn a_partial_block_and_a_single_network_give_the_same_fitness_as_a_full_block() 
 fn a_network_whose_thrust_turns_nan_gets_the_scalar_paths_error() {
     // Finite weights cannot make NaN (every sum is a fused multiply-add),
     // but an absurd input scale can: on task 3 the y input becomes -inf,
-    // and its weight of 0 times -inf is NaN.
-    let mut settings = native(PsaSettings::default());
-    settings.sensors.position_scale = 1e308;
-    let mut genes = vec![0.0; 11];
-    genes[7..11].copy_from_slice(&[1.0; 4]);
-    let bad = Network::from_genes(7, 4, genes).unwrap();
-    let good = random_network(1);
-    let scalar = TrialRunner::new(&settings, Task::StopAtPosition)
-        .unwrap()
-        .evaluate(&bad, &mut stream(0, &[]))
-        .unwrap_err();
-    let batched = BatchRunner::new(&settings, Task::StopAtPosition)
-        .unwrap()
-        .evaluate(&[&good, &bad], &mut [stream(1, &[]), stream(0, &[])])
-        .unwrap_err();
-    assert_eq!(batched.to_string(), scalar.to_string());
-    assert!(scalar.to_string().contains("thrust"), "{scalar}");
+    // and its weight of 0 times -inf is NaN. With and without output noise
+    // (the noisy kernel is compiled apart).
+    for output_sd in [0.0, 0.1] {
+        let mut settings = native(PsaSettings::default());
+        settings.sensors.position_scale = 1e308;
+        settings.noise.output_sd = output_sd;
+        let mut genes = vec![0.0; 11];
+        genes[7..11].copy_from_slice(&[1.0; 4]);
+        let bad = Network::from_genes(7, 4, genes).unwrap();
+        let good = random_network(1);
+        let scalar = TrialRunner::new(&settings, Task::StopAtPosition)
+            .unwrap()
+            .evaluate(&bad, &mut stream(0, &[]))
+            .unwrap_err();
+        let batched = BatchRunner::new(&settings, Task::StopAtPosition)
+            .unwrap()
+            .evaluate(&[&good, &bad], &mut [stream(1, &[]), stream(0, &[])])
+            .unwrap_err();
+        assert_eq!(batched.to_string(), scalar.to_string());
+        assert!(scalar.to_string().contains("thrust"), "{scalar}");
+    }
 }
 
 #[test]

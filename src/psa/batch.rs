@@ -77,7 +77,13 @@ struct Flight<'a, const N: usize> {
 /// One trial of every lane from `state` towards `target` (x, y, heading),
 /// with lane l's noise from lane l of `noise` if `NOISY` (compiled apart, so
 /// that the noise code costs noiseless flights nothing). Returns the points
-/// and which lanes kept a valid thrust.
+/// and which lanes ended with a finite velocity and spin.
+///
+/// A lane whose thrust turned NaN is always among those that did not: a NaN
+/// command makes its thruster's world-frame force NaN, and from then on the
+/// velocity and the spin stay NaN. So checking them once, after the flight,
+/// finds every such lane (and, conservatively, any lane whose state
+/// overflowed), without a check per step.
 #[inline(always)]
 fn fly<const N: usize, const NOISY: bool>(
     flight: &Flight<N>,
@@ -88,9 +94,8 @@ fn fly<const N: usize, const NOISY: bool>(
     type V<const N: usize> = Lanes<N>;
     let s = flight.settings;
     let weights = flight.weights;
-    let (zero, one) = (V::<N>::splat(0.0), V::<N>::splat(1.0));
+    let zero = V::<N>::splat(0.0);
     let mut points = zero;
-    let mut valid = one.le(one);
     let mut heading_error = wrap_angle(state.heading() - target[2]);
     for _ in 0..s.steps {
         let offset = [state.position[0] - target[0], state.position[1] - target[1]];
@@ -116,12 +121,13 @@ fn fly<const N: usize, const NOISY: bool>(
         for o in &mut outputs {
             *o = sigmoid(*o);
         }
+        // The logistic function's values lie in [0, 1] already (1 / (1 + e)
+        // with e > 0): clamping changes them only after noise.
         if NOISY {
             s.noise.perturb_outputs(&mut outputs, noise);
-        }
-        for o in &mut outputs {
-            *o = clamp_unit(*o);
-            valid = valid & o.le(one);
+            for o in &mut outputs {
+                *o = clamp_unit(*o);
+            }
         }
         let previous_omega = state.omega;
         flight.body.step(state, &outputs);
@@ -135,7 +141,11 @@ fn fly<const N: usize, const NOISY: bool>(
                 previous_omega,
             });
     }
-    (points, valid)
+    let finite = |v: V<N>| v.abs().le(V::<N>::splat(f64::MAX));
+    (
+        points,
+        finite(state.velocity[0]) & finite(state.velocity[1]) & finite(state.omega),
+    )
 }
 
 /// The kernel of width `$n`, with or without noise, as a function with the
