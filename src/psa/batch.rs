@@ -4,7 +4,10 @@
 //!
 //! Weights and states are kept as structures of arrays ([`Lanes`]), and every
 //! step runs the arithmetic the scalar path ([`TrialRunner`] with the
-//! `native` backend) runs, operation for operation: the shared generic
+//! `native` backend) runs, operation for operation, but for two that
+//! cannot change a value (clamping noiseless outputs that lie in [0, 1]
+//! already, and a NaN check per step, made once per flight instead; see
+//! `fly`): the shared generic
 //! functions of [`crate::numeric`], [`PlanarBody::step`],
 //! [`SensorSettings::inputs_from`](super::SensorSettings::inputs_from) and
 //! [`FitnessSettings::points`](super::FitnessSettings::points), and the
