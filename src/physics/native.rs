@@ -43,25 +43,26 @@ struct MountedThruster {
 /// velocities and positions are the same, bit for bit, with or without
 /// those products, and skipping them spares the axis-aligned thrusters of
 /// the PSA almost half of their arithmetic.
+///
+/// A zero vector (a force that underflowed, a mount at the centre of mass)
+/// keeps both products, so that a NaN command still turns the force NaN
+/// (see `crate::psa::batch`, which relies on that to find NaN thrust).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Support {
-    /// Both components are zero.
-    Neither,
     /// Only x is non-zero.
     X,
     /// Only y is non-zero.
     Y,
-    /// Both are non-zero.
+    /// Both components are kept.
     Both,
 }
 
 impl Support {
     fn of(v: [f64; 2]) -> Support {
         match (v[0] != 0.0, v[1] != 0.0) {
-            (false, false) => Support::Neither,
             (true, false) => Support::X,
             (false, true) => Support::Y,
-            (true, true) => Support::Both,
+            _ => Support::Both,
         }
     }
 
@@ -70,7 +71,6 @@ impl Support {
     #[inline(always)]
     fn rotate<R: Real>(self, r: [[R; 2]; 2], x: impl Fn() -> R, y: impl Fn() -> R) -> [R; 2] {
         match self {
-            Support::Neither => [R::splat(0.0); 2],
             Support::X => {
                 let x = x();
                 [r[0][0] * x, r[1][0] * x]
@@ -303,7 +303,7 @@ mod tests {
     use super::*;
 
     /// A hull with the PSA's four axis-aligned thrusters, a diagonal one and
-    /// one pushing through the centre of mass: every kind of support.
+    /// one pushing through the centre of mass (a zero arm): every kind of support.
     fn model() -> RigidBodyModel {
         let thruster = |mount, direction| super::super::Thruster { mount, direction };
         let diagonal = std::f64::consts::FRAC_1_SQRT_2;
@@ -338,7 +338,7 @@ mod tests {
         assert_eq!(supports[0], (Support::X, Support::Y));
         assert_eq!(supports[1], (Support::Y, Support::X));
         assert_eq!(supports[4], (Support::Both, Support::Both));
-        assert_eq!(supports[5], (Support::Y, Support::Neither));
+        assert_eq!(supports[5], (Support::Y, Support::Both));
         let mut full = skipping.clone();
         for t in &mut full.thrusters {
             (t.force_support, t.arm_support) = (Support::Both, Support::Both);

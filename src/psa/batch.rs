@@ -83,10 +83,9 @@ struct Flight<'a, const N: usize> {
 /// and which lanes ended with a finite velocity and spin.
 ///
 /// A lane whose thrust turned NaN is always among those that did not: a NaN
-/// command makes its thruster's world-frame force NaN (every thruster's
-/// force is non-zero, as the body model's validation demands a unit
-/// direction and a positive force), and from then on the velocity and the
-/// spin stay NaN. So checking them once, after the flight,
+/// command makes its thruster's world-frame force NaN (`PlanarBody` keeps
+/// every product of a force that is not axis-aligned, a zero one
+/// included), and from then on the velocity and the spin stay NaN. So checking them once, after the flight,
 /// finds every such lane (and, conservatively, any lane whose state
 /// overflowed), without a check per step.
 #[inline(always)]
