@@ -45,8 +45,8 @@ struct MountedThruster {
 /// the PSA almost half of their arithmetic.
 ///
 /// A zero vector (a force that underflowed, a mount at the centre of mass)
-/// keeps both products, so that a NaN command still turns the force NaN
-/// (see `crate::psa::batch`, which relies on that to find NaN thrust).
+/// keeps both products, so that a NaN command always turns the force, and
+/// with it the velocity, NaN: callers may find NaN thrust from the state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Support {
     /// Only x is non-zero.

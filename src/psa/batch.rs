@@ -85,9 +85,10 @@ struct Flight<'a, const N: usize> {
 /// A lane whose thrust turned NaN is always among those that did not: a NaN
 /// command makes its thruster's world-frame force NaN (`PlanarBody` keeps
 /// every product of a force that is not axis-aligned, a zero one
-/// included), and from then on the velocity and the spin stay NaN. So checking them once, after the flight,
-/// finds every such lane (and, conservatively, any lane whose state
-/// overflowed), without a check per step.
+/// included), and from then on the velocity and the spin stay NaN. So
+/// checking them once, after the flight, finds every such lane (and,
+/// conservatively, any lane whose state overflowed), without a check per
+/// step.
 #[inline(always)]
 fn fly<const N: usize, const NOISY: bool>(
     flight: &Flight<N>,
