@@ -25,15 +25,16 @@ pub const SIMD_VARIABLE: &str = "PSA_ESP_SIMD";
 pub struct PsaEvaluator {
     settings: PsaSettings,
     task: Task,
-    /// The batched runner, built once and cloned into every worker.
+    /// The batched runner, built once and used by every worker thread.
     batch: Option<BatchRunner>,
 }
 
-/// A worker thread's state: the scalar runner (made when first needed: the
-/// batched path needs it only to report errors), and the batched one on `native`.
+/// A worker thread's state: its scalar runner, which owns the thread's
+/// physics world. With the batched path it is made when first needed (only
+/// to evaluate one network on its own); the batched runner holds no state
+/// of its own and is shared by every thread.
 pub struct PsaWorker {
     scalar: Option<TrialRunner>,
-    batch: Option<BatchRunner>,
 }
 
 impl PsaEvaluator {
@@ -97,7 +98,6 @@ impl Evaluator for PsaEvaluator {
                 None => Some(TrialRunner::new(&self.settings, self.task)?),
                 Some(_) => None,
             },
-            batch: self.batch.clone(),
         })
     }
     fn evaluate(&self, worker: &mut PsaWorker, network: &Network, rng: &mut Stream) -> Result<f64> {
@@ -111,7 +111,7 @@ impl Evaluator for PsaEvaluator {
         }
     }
     fn evaluate_batch(&self, worker: &mut PsaWorker, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>> {
-        match &worker.batch {
+        match &self.batch {
             Some(batch) => Ok(batch.evaluate(networks, rngs)?),
             None => networks
                 .iter()
