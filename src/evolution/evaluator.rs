@@ -1,5 +1,10 @@
 //! What the algorithms search against: anything that scores a network.
 
+use std::ops::Range;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
 use anyhow::{anyhow, Result};
 use rayon::prelude::*;
 
@@ -87,39 +92,383 @@ where
 
 /// Evaluates `networks` in parallel on the current rayon pool; network `j`
 /// gets the stream `stream(seed, [key.., j])`. A batched evaluator gets
-/// them in one even share per thread (it splits a share into its own
-/// blocks), any other one network at a time. The result is in order and
-/// independent of the thread count and of the batching.
+/// them in batches of its [`Evaluator::batch_size`], which the threads take
+/// as they come free (see [`evaluate_batches`]), any other one network at
+/// a time. The result is in order and independent of the thread count and
+/// of the batching.
 pub fn evaluate_all<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64, key: &[u64]) -> Result<Vec<f64>> {
-    let batch = match evaluator.batch_size() {
-        0 | 1 => 1,
-        _ => networks.len().div_ceil(rayon::current_num_threads()).max(1),
-    };
-    let batches: Vec<Vec<f64>> = networks
-        .par_chunks(batch)
+    if evaluator.batch_size() > 1 {
+        return evaluate_batches(evaluator, networks, seed, key);
+    }
+    networks
+        .par_iter()
         .enumerate()
         .map_init(
             || evaluator.worker().map_err(|e| format!("{e:#}")),
-            |worker, (b, chunk)| {
+            |worker, (j, network)| {
                 let worker = worker
                     .as_mut()
                     .map_err(|e| anyhow!("cannot set up an evaluation worker: {e}"))?;
-                let first = b * batch;
-                let mut full_key = [key, &[0]].concat();
-                let mut rngs: Vec<Stream> = (first..first + chunk.len())
-                    .map(|j| {
-                        *full_key.last_mut().expect("the key has the network index") = j as u64;
-                        stream(seed, &full_key)
-                    })
-                    .collect();
-                let refs: Vec<&Network> = chunk.iter().collect();
-                let fitness = evaluator.evaluate_batch(worker, &refs, &mut rngs)?;
-                if let Some(i) = fitness.iter().position(|f| f.is_nan()) {
-                    return Err(anyhow!("the evaluation returned NaN for network {}", first + i));
-                }
+                let fitness = evaluator.evaluate(worker, network, &mut streams(seed, key, j..j + 1).remove(0))?;
+                check_fitness(&[fitness], j)?;
                 Ok(fitness)
             },
         )
-        .collect::<Result<_>>()?;
-    Ok(batches.concat())
+        .collect()
+}
+
+/// The streams of networks `range`: network `j`'s is keyed by `key` and `j`.
+fn streams(seed: u64, key: &[u64], range: Range<usize>) -> Vec<Stream> {
+    let mut full_key = [key, &[0]].concat();
+    range
+        .map(|j| {
+            *full_key.last_mut().expect("the key has the network index") = j as u64;
+            stream(seed, &full_key)
+        })
+        .collect()
+}
+
+/// An error naming the first network whose fitness is NaN; `first` is the
+/// index of `fitness[0]`.
+fn check_fitness(fitness: &[f64], first: usize) -> Result<()> {
+    match fitness.iter().position(|f| f.is_nan()) {
+        Some(i) => Err(anyhow!("the evaluation returned NaN for network {}", first + i)),
+        None => Ok(()),
+    }
+}
+
+/// Counts the calls of [`evaluate_batches`]: a thread kept awake after one
+/// (see [`keep_warm`]) goes back to rayon when the next begins.
+static BATCH_CALLS: AtomicU64 = AtomicU64::new(0);
+
+/// How long a helper thread stays awake for the next generation's
+/// evaluations before it goes back to rayon, which puts idle threads to
+/// sleep. ESP's own work between two evaluations takes well under this.
+const KEEP_WARM: Duration = Duration::from_millis(2);
+
+/// The batches `networks` networks are evaluated in: as many full batches
+/// of `size` as fit, then what is left in one piece per thread, so that
+/// the threads finish together.
+fn batch_ranges(networks: usize, size: usize, threads: usize) -> Vec<Range<usize>> {
+    let full = networks / size * size;
+    let mut ranges: Vec<Range<usize>> = (0..full).step_by(size).map(|start| start..start + size).collect();
+    let left = networks - full;
+    let pieces = threads.clamp(1, left.max(1));
+    ranges.extend(
+        (0..pieces)
+            .map(|p| full + left * p / pieces..full + left * (p + 1) / pieces)
+            .filter(|range| !range.is_empty()),
+    );
+    ranges
+}
+
+/// The batches of one [`evaluate_batches`] call, taken one at a time by
+/// whichever thread is free.
+struct Batches<'a> {
+    networks: &'a [Network],
+    ranges: Vec<Range<usize>>,
+    /// The next batch to take.
+    next: AtomicUsize,
+    /// Batches finished (or abandoned by a panic).
+    done: AtomicUsize,
+    results: Vec<Mutex<Option<Result<Vec<f64>>>>>,
+}
+
+/// Counts a batch as done when dropped, so that a panicking evaluation
+/// never leaves the calling thread waiting for it.
+struct CountDone<'a>(&'a AtomicUsize);
+
+impl Drop for CountDone<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_add(1, Ordering::Release);
+    }
+}
+
+impl Batches<'_> {
+    /// Takes and evaluates batches until none is left.
+    fn take_and_run<E: Evaluator>(&self, evaluator: &E, seed: u64, key: &[u64]) {
+        let mut worker = None;
+        loop {
+            let b = self.next.fetch_add(1, Ordering::AcqRel);
+            let Some(range) = self.ranges.get(b) else {
+                return;
+            };
+            let _done = CountDone(&self.done);
+            let result = self.evaluate(evaluator, &mut worker, range.clone(), seed, key);
+            *self.results[b].lock().expect("no panics while holding the lock") = Some(result);
+        }
+    }
+
+    fn evaluate<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        worker: &mut Option<E::Worker>,
+        range: Range<usize>,
+        seed: u64,
+        key: &[u64],
+    ) -> Result<Vec<f64>> {
+        let worker = match worker {
+            Some(worker) => worker,
+            None => worker.insert(
+                evaluator
+                    .worker()
+                    .map_err(|e| anyhow!("cannot set up an evaluation worker: {e:#}"))?,
+            ),
+        };
+        let mut rngs = streams(seed, key, range.clone());
+        let refs: Vec<&Network> = self.networks[range.clone()].iter().collect();
+        let fitness = evaluator.evaluate_batch(worker, &refs, &mut rngs)?;
+        check_fitness(&fitness, range.start)?;
+        Ok(fitness)
+    }
+}
+
+/// [`evaluate_all`] for a batched evaluator: batches of
+/// [`Evaluator::batch_size`] networks (see [`batch_ranges`]), which the
+/// threads take one at a time as they come free, so that a thread slowed
+/// down (on a shared host, say) does less of the work.
+///
+/// The calling thread offers the pool one helper job per other thread,
+/// takes batches until none is left, and then waits for the batches the
+/// helpers are evaluating without going to sleep (it yields its core
+/// while it waits). A thread that is busy elsewhere (in `replicate`, every
+/// thread runs a run of its own) never holds any batch up: the caller
+/// takes every batch no helper took. Rayon would put a waiting thread to
+/// sleep, and on a virtual machine waking a sleeping thread takes a tenth
+/// of a millisecond or more, twice per generation (once to start a helper,
+/// once to resume the caller). For the same reason the helpers are kept
+/// awake until the next call (see [`keep_warm`]).
+///
+/// `evaluate_batch` must not wait on rayon itself (the evaluator's work is
+/// plain computation): a thread waits only for batches that other threads
+/// are evaluating.
+fn evaluate_batches<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64, key: &[u64]) -> Result<Vec<f64>> {
+    BATCH_CALLS.fetch_add(1, Ordering::AcqRel);
+    let threads = rayon::current_num_threads();
+    let ranges = batch_ranges(networks.len(), evaluator.batch_size(), threads);
+    let batches = Batches {
+        networks,
+        results: ranges.iter().map(|_| Mutex::new(None)).collect(),
+        ranges,
+        next: AtomicUsize::new(0),
+        done: AtomicUsize::new(0),
+    };
+    let helpers = threads.min(batches.ranges.len()).saturating_sub(1);
+    rayon::scope(|scope| {
+        for _ in 0..helpers {
+            scope.spawn(|_| batches.take_and_run(evaluator, seed, key));
+        }
+        batches.take_and_run(evaluator, seed, key);
+        while batches.done.load(Ordering::Acquire) < batches.ranges.len() {
+            std::thread::yield_now();
+        }
+    });
+    for _ in 0..helpers {
+        keep_warm();
+    }
+    let mut fitness = Vec::with_capacity(networks.len());
+    for result in batches.results {
+        let result = result.into_inner().expect("no panics while holding the lock");
+        fitness.extend(result.expect("every batch was evaluated")?);
+    }
+    Ok(fitness)
+}
+
+/// Offers the pool a job that keeps the thread that takes it awake
+/// (yielding its core) until the next [`evaluate_batches`] call, for at
+/// most [`KEEP_WARM`], so that it can take a batch at once. Only a thread
+/// that steals the job waits: a thread steals only when it has nothing
+/// else to do, while the offering thread could pop it from its own queue
+/// in the middle of other work (waiting for a rayon job, say), so there it
+/// returns at once.
+fn keep_warm() {
+    let call = BATCH_CALLS.load(Ordering::Acquire);
+    let offered_by = rayon::current_thread_index();
+    rayon::spawn(move || {
+        if rayon::current_thread_index() == offered_by {
+            return;
+        }
+        let start = Instant::now();
+        while BATCH_CALLS.load(Ordering::Acquire) == call && start.elapsed() < KEEP_WARM {
+            std::thread::yield_now();
+        }
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::Rng;
+
+    use super::*;
+
+    /// A batched evaluator whose fitness is network `j`'s first gene plus
+    /// the first draw of its stream; `fail_at` makes the network with that
+    /// first gene an error, `nan_at` a NaN.
+    struct Batched {
+        fail_at: Option<f64>,
+        nan_at: Option<f64>,
+    }
+
+    impl Evaluator for Batched {
+        type Worker = ();
+        fn inputs(&self) -> usize {
+            1
+        }
+        fn outputs(&self) -> usize {
+            1
+        }
+        fn worker(&self) -> Result<()> {
+            Ok(())
+        }
+        fn evaluate(&self, _: &mut (), network: &Network, rng: &mut Stream) -> Result<f64> {
+            let gene = network.neuron(0)[0];
+            if Some(gene) == self.fail_at {
+                return Err(anyhow!("network with gene {gene} failed"));
+            }
+            if Some(gene) == self.nan_at {
+                return Ok(f64::NAN);
+            }
+            Ok(gene + (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+        }
+        fn batch_size(&self) -> usize {
+            8
+        }
+    }
+
+    fn networks(count: usize) -> Vec<Network> {
+        (0..count)
+            .map(|j| Network::from_genes(1, 1, vec![j as f64, 0.5]).expect("finite genes"))
+            .collect()
+    }
+
+    fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+    }
+
+    const CLEAN: Batched = Batched {
+        fail_at: None,
+        nan_at: None,
+    };
+
+    #[test]
+    fn full_batches_come_first_and_the_rest_is_split_over_the_threads() {
+        let ranges = |n, threads| batch_ranges(n, 32, threads);
+        assert_eq!(
+            ranges(400, 1),
+            [
+                0..32,
+                32..64,
+                64..96,
+                96..128,
+                128..160,
+                160..192,
+                192..224,
+                224..256,
+                256..288,
+                288..320,
+                320..352,
+                352..384,
+                384..400
+            ]
+        );
+        assert_eq!(ranges(400, 2)[11..], [352..384, 384..392, 392..400]);
+        assert_eq!(ranges(64, 2), [0..32, 32..64]);
+        assert_eq!(ranges(5, 2), [0..2, 2..5]);
+        assert_eq!(ranges(3, 8), [0..1, 1..2, 2..3]);
+        assert!(ranges(0, 2).is_empty());
+    }
+
+    #[test]
+    fn batches_give_each_network_its_own_stream_whatever_the_thread_count() {
+        let nets = networks(45);
+        let expected: Vec<f64> = nets
+            .iter()
+            .enumerate()
+            .map(|(j, n)| CLEAN.evaluate(&mut (), n, &mut stream(5, &[3, 9, j as u64])).unwrap())
+            .collect();
+        for threads in [1, 2, 3, 5] {
+            for _ in 0..20 {
+                let got = pool(threads)
+                    .install(|| evaluate_all(&CLEAN, &nets, 5, &[3, 9]))
+                    .unwrap();
+                assert_eq!(got, expected, "{threads} threads");
+            }
+        }
+        assert!(pool(2)
+            .install(|| evaluate_all(&CLEAN, &[], 5, &[]))
+            .unwrap()
+            .is_empty());
+    }
+
+    #[test]
+    fn an_error_or_nan_in_any_batch_names_its_network() {
+        let nets = networks(40);
+        for threads in [1, 2, 4] {
+            let failing = Batched {
+                fail_at: Some(33.0),
+                nan_at: None,
+            };
+            let error = pool(threads)
+                .install(|| evaluate_all(&failing, &nets, 1, &[]))
+                .unwrap_err();
+            assert!(format!("{error:#}").contains("gene 33 failed"), "{error:#}");
+            let nan = Batched {
+                fail_at: None,
+                nan_at: Some(21.0),
+            };
+            let error = pool(threads).install(|| evaluate_all(&nan, &nets, 1, &[])).unwrap_err();
+            assert!(error.to_string().contains("NaN for network 21"), "{error}");
+        }
+    }
+
+    #[test]
+    fn concurrent_evaluations_on_a_busy_pool_finish_with_the_right_results() {
+        // As in `replicate`: every thread runs work of its own that calls
+        // evaluate_all again and again, so no thread is free to take
+        // another's batches; each must evaluate its own.
+        let nets = networks(50);
+        let expected = pool(1).install(|| evaluate_all(&CLEAN, &nets, 2, &[7])).unwrap();
+        let runs: Vec<Vec<f64>> = pool(2).install(|| {
+            (0..6)
+                .into_par_iter()
+                .map(|_| {
+                    let mut last = Vec::new();
+                    for _ in 0..200 {
+                        last = evaluate_all(&CLEAN, &nets, 2, &[7]).unwrap();
+                    }
+                    last
+                })
+                .collect()
+        });
+        assert!(runs.iter().all(|r| *r == expected));
+    }
+
+    #[test]
+    #[should_panic(expected = "evaluator panicked")]
+    fn a_panicking_batch_panics_the_caller_instead_of_leaving_it_waiting() {
+        struct Panicking;
+        impl Evaluator for Panicking {
+            type Worker = ();
+            fn inputs(&self) -> usize {
+                1
+            }
+            fn outputs(&self) -> usize {
+                1
+            }
+            fn worker(&self) -> Result<()> {
+                Ok(())
+            }
+            fn evaluate(&self, _: &mut (), network: &Network, _: &mut Stream) -> Result<f64> {
+                assert!(network.neuron(0)[0] < 30.0, "evaluator panicked");
+                Ok(0.0)
+            }
+            fn batch_size(&self) -> usize {
+                8
+            }
+        }
+        let _ = pool(2).install(|| evaluate_all(&Panicking, &networks(40), 1, &[]));
+    }
 }
