@@ -93,9 +93,10 @@ where
 /// Evaluates `networks` in parallel on the current rayon pool; network `j`
 /// gets the stream `stream(seed, [key.., j])`. A batched evaluator gets
 /// them in batches of its [`Evaluator::batch_size`], which the threads take
-/// as they come free (see [`evaluate_batches`]), any other one network at
-/// a time. The result is in order and independent of the thread count and
-/// of the batching.
+/// as they come free (the calling thread waits for the others' batches
+/// without going to sleep, and they stay awake until the next call), any
+/// other one network at a time. The result is in order and independent of
+/// the thread count and of the batching.
 pub fn evaluate_all<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64, key: &[u64]) -> Result<Vec<f64>> {
     if evaluator.batch_size() > 1 {
         return evaluate_batches(evaluator, networks, seed, key);
