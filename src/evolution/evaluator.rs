@@ -304,10 +304,12 @@ mod tests {
 
     /// A batched evaluator whose fitness is network `j`'s first gene plus
     /// the first draw of its stream; `fail_at` makes the network with that
-    /// first gene an error, `nan_at` a NaN.
+    /// first gene an error, `nan_at` a NaN, and any gene from `panic_from`
+    /// on a panic.
     struct Batched {
         fail_at: Option<f64>,
         nan_at: Option<f64>,
+        panic_from: Option<f64>,
     }
 
     impl Evaluator for Batched {
@@ -323,6 +325,7 @@ mod tests {
         }
         fn evaluate(&self, _: &mut (), network: &Network, rng: &mut Stream) -> Result<f64> {
             let gene = network.neuron(0)[0];
+            assert!(self.panic_from.is_none_or(|from| gene < from), "evaluator panicked");
             if Some(gene) == self.fail_at {
                 return Err(anyhow!("network with gene {gene} failed"));
             }
@@ -352,6 +355,7 @@ mod tests {
     const CLEAN: Batched = Batched {
         fail_at: None,
         nan_at: None,
+        panic_from: None,
     };
 
     #[test]
@@ -410,15 +414,15 @@ mod tests {
         for threads in [1, 2, 4] {
             let failing = Batched {
                 fail_at: Some(33.0),
-                nan_at: None,
+                ..CLEAN
             };
             let error = pool(threads)
                 .install(|| evaluate_all(&failing, &nets, 1, &[]))
                 .unwrap_err();
             assert!(format!("{error:#}").contains("gene 33 failed"), "{error:#}");
             let nan = Batched {
-                fail_at: None,
                 nan_at: Some(21.0),
+                ..CLEAN
             };
             let error = pool(threads).install(|| evaluate_all(&nan, &nets, 1, &[])).unwrap_err();
             assert!(error.to_string().contains("NaN for network 21"), "{error}");
@@ -450,26 +454,10 @@ mod tests {
     #[test]
     #[should_panic(expected = "evaluator panicked")]
     fn a_panicking_batch_panics_the_caller_instead_of_leaving_it_waiting() {
-        struct Panicking;
-        impl Evaluator for Panicking {
-            type Worker = ();
-            fn inputs(&self) -> usize {
-                1
-            }
-            fn outputs(&self) -> usize {
-                1
-            }
-            fn worker(&self) -> Result<()> {
-                Ok(())
-            }
-            fn evaluate(&self, _: &mut (), network: &Network, _: &mut Stream) -> Result<f64> {
-                assert!(network.neuron(0)[0] < 30.0, "evaluator panicked");
-                Ok(0.0)
-            }
-            fn batch_size(&self) -> usize {
-                8
-            }
-        }
-        let _ = pool(2).install(|| evaluate_all(&Panicking, &networks(40), 1, &[]));
+        let panicking = Batched {
+            panic_from: Some(30.0),
+            ..CLEAN
+        };
+        let _ = pool(2).install(|| evaluate_all(&panicking, &networks(40), 1, &[]));
     }
 }
