@@ -2,7 +2,7 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
@@ -172,7 +172,8 @@ struct Batches<'a> {
     next: AtomicUsize,
     /// Batches finished (or abandoned by a panic).
     done: AtomicUsize,
-    results: Vec<Mutex<Option<Result<Vec<f64>>>>>,
+    /// Each batch's result, set once by the thread that took it.
+    results: Vec<OnceLock<Result<Vec<f64>>>>,
 }
 
 /// Counts a batch as done when dropped, so that a panicking evaluation
@@ -196,7 +197,7 @@ impl Batches<'_> {
             };
             let _done = CountDone(&self.done);
             let result = self.evaluate(evaluator, &mut worker, range.clone(), seed, key);
-            *self.results[b].lock().expect("no panics while holding the lock") = Some(result);
+            assert!(self.results[b].set(result).is_ok(), "each batch is taken once");
         }
     }
 
@@ -249,7 +250,7 @@ fn evaluate_batches<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64
     let ranges = batch_ranges(networks.len(), evaluator.batch_size(), threads);
     let batches = Batches {
         networks,
-        results: ranges.iter().map(|_| Mutex::new(None)).collect(),
+        results: ranges.iter().map(|_| OnceLock::new()).collect(),
         ranges,
         next: AtomicUsize::new(0),
         done: AtomicUsize::new(0),
@@ -269,8 +270,7 @@ fn evaluate_batches<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64
     }
     let mut fitness = Vec::with_capacity(networks.len());
     for result in batches.results {
-        let result = result.into_inner().expect("no panics while holding the lock");
-        fitness.extend(result.expect("every batch was evaluated")?);
+        fitness.extend(result.into_inner().expect("every batch was evaluated")?);
     }
     Ok(fitness)
 }
