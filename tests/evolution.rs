@@ -100,6 +100,11 @@ fn configuration_files_override_settings_and_reject_bad_keys_and_values() {
         ("[esp]\nsubpop_size = -3\n", "subpop_size"),
         ("[esp]\nmutation_rate = 1.5\n", "esp.mutation_rate"),
         ("[hill_climb]\np_flip = -0.1\n", "hill_climb.p_flip"),
+        ("[esp]\ninit_range = 1e308\n", "esp.init_range must be at most"),
+        (
+            "[hill_climb]\ninit_range = 1e308\n",
+            "hill_climb.init_range must be at most",
+        ),
         ("[esp]\ngenerations = 0\n", "esp.generations"),
         ("[esp]\nsubpop_size = 0\n", "esp.subpop_size"),
         ("[problem]\nsteps = 0\n", "steps"),

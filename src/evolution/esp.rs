@@ -7,7 +7,9 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use super::operators::{cauchy, crossover, mutate_one_gene, random_genes};
-use super::{best_of, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose};
+use super::{
+    best_of, check_count, check_init_range, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
+};
 use super::{Champion, Evaluator, GenerationRecord, LesionOutcome, RunResult};
 use crate::network::Network;
 use crate::rng::stream;
@@ -130,7 +132,7 @@ impl EspSettings {
         check_count("esp.generations", self.generations, 1)?;
         check_count("esp.stagnation", self.stagnation, 1)?;
         check_count("esp.bursts_before_lesion", self.bursts_before_lesion, 1)?;
-        check_positive("esp.init_range", self.init_range)?;
+        check_init_range("esp.init_range", self.init_range)?;
         check_positive("esp.mutation_scale", self.mutation_scale)?;
         check_positive("esp.cauchy_limit", self.cauchy_limit)?;
         check_positive("esp.burst_scale", self.burst_scale)?;

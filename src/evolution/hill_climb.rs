@@ -5,7 +5,9 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use super::operators::{cauchy, random_genes};
-use super::{best_of, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose};
+use super::{
+    best_of, check_count, check_init_range, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
+};
 use super::{Champion, Evaluator, GenerationRecord, RunResult};
 use crate::network::Network;
 use crate::rng::{stream, Stream};
@@ -65,7 +67,7 @@ impl HillClimbSettings {
         check_count("hill_climb.hidden", self.hidden, 1)?;
         check_count("hill_climb.candidates", self.candidates, 1)?;
         check_count("hill_climb.cycles", self.cycles, 1)?;
-        check_positive("hill_climb.init_range", self.init_range)?;
+        check_init_range("hill_climb.init_range", self.init_range)?;
         check_positive("hill_climb.alpha", self.alpha)?;
         check_positive("hill_climb.cauchy_limit", self.cauchy_limit)?;
         check_probability("hill_climb.p_noise", self.p_noise)?;

@@ -74,6 +74,20 @@ pub(crate) fn check_positive(name: &str, v: f64) -> Result<(), String> {
     }
 }
 
+/// Checks the half-width of an initial weight interval (-v, v): positive,
+/// and small enough for the interval's width to be finite.
+pub(crate) fn check_init_range(name: &str, v: f64) -> Result<(), String> {
+    check_positive(name, v)?;
+    if (2.0 * v).is_finite() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{name} must be at most {:e}, so that (-{name}, {name}) has a finite width, got {v}",
+            f64::MAX / 2.0
+        ))
+    }
+}
+
 /// Checks a count setting.
 pub(crate) fn check_count(name: &str, n: usize, min: usize) -> Result<(), String> {
     if n >= min {
