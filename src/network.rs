@@ -33,12 +33,16 @@ pub fn sigmoid(x: f64) -> f64 {
     crate::numeric::sigmoid(x)
 }
 
-/// The index of the first non-finite weight, if any. Checks all weights in
-/// one pass without early exit, which the compiler vectorises: ESP copies
-/// every neuron into a network each generation, so this check runs
-/// thousands of times per generation.
-fn first_non_finite(genes: &[f64]) -> Option<usize> {
-    if genes.iter().fold(true, |finite, v| finite & v.is_finite()) {
+/// Whether every weight is finite: one pass without early exit, which the
+/// compiler vectorises.
+fn all_finite(genes: &[f64]) -> bool {
+    genes.iter().fold(true, |finite, v| finite & v.is_finite())
+}
+
+/// The index of the first non-finite weight, if any; a single vectorised
+/// pass when there is none.
+pub(crate) fn first_non_finite(genes: &[f64]) -> Option<usize> {
+    if all_finite(genes) {
         return None;
     }
     genes.iter().position(|v| !v.is_finite())
@@ -133,30 +137,28 @@ impl Network {
         &self.genes[k * per..(k + 1) * per]
     }
 
-    /// Overwrites the genes of hidden neuron `k` (input weights, then output
-    /// weights); its lesion flag is cleared. Fails on a wrong length or a
-    /// non-finite weight, leaving the network unchanged.
+    /// Overwrites the hidden neurons, neuron k with the k-th slice of
+    /// `neurons` (input weights, then output weights), and switches every
+    /// lesioned neuron back on.
+    ///
+    /// This is ESP's assembly of each generation's networks, its hottest
+    /// path outside evaluation, so it does not check the weights: the
+    /// caller has checked that they are finite (ESP checks each
+    /// sub-population once per generation), and debug builds check again.
     ///
     /// # Panics
-    /// If `k` is not a hidden neuron.
-    pub fn set_neuron(&mut self, k: usize, genes: &[f64]) -> Result<(), NetworkError> {
+    /// If a slice's length is not `inputs + outputs`, or there are fewer
+    /// slices than hidden neurons.
+    pub(crate) fn copy_neurons<'a>(&mut self, neurons: impl IntoIterator<Item = &'a [f64]>) {
         let per = self.genes_per_neuron();
-        if genes.len() != per {
-            return Err(NetworkError::Shape(format!(
-                "hidden neuron {k} needs {per} weights, got {}",
-                genes.len()
-            )));
+        let mut copied = 0;
+        for (slot, genes) in self.genes.chunks_exact_mut(per).zip(neurons) {
+            slot.copy_from_slice(genes);
+            copied += 1;
         }
-        if let Some(index) = first_non_finite(genes) {
-            return Err(NetworkError::NonFinite {
-                neuron: k,
-                index,
-                value: genes[index],
-            });
-        }
-        self.genes[k * per..(k + 1) * per].copy_from_slice(genes);
-        self.lesioned[k] = false;
-        Ok(())
+        assert_eq!(copied, self.hidden(), "one gene set per hidden neuron");
+        debug_assert!(all_finite(&self.genes), "non-finite weights copied into a network");
+        self.lesioned.fill(false);
     }
 
     /// Switches hidden neuron `k` off (`true`) or on.
@@ -235,17 +237,19 @@ mod tests {
     }
 
     #[test]
-    fn set_neuron_overwrites_one_neuron_and_refuses_bad_genes() {
+    fn copy_neurons_overwrites_every_neuron_and_clears_lesions() {
         let mut net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
         net.set_lesioned(1, true);
-        net.set_neuron(1, &[4.0, 5.0, 6.0]).unwrap();
-        assert_eq!(net.genes(), &[1.0, -1.0, 2.0, 4.0, 5.0, 6.0]);
+        net.copy_neurons([&[7.0, 8.0, 9.0][..], &[4.0, 5.0, 6.0]]);
+        assert_eq!(net.genes(), &[7.0, 8.0, 9.0, 4.0, 5.0, 6.0]);
         assert!(!net.is_lesioned(1));
-        assert!(net.set_neuron(0, &[1.0, 2.0]).is_err());
-        assert!(net.set_neuron(0, &[1.0, f64::NAN, 2.0]).is_err());
-        let err = net.set_neuron(0, &[1.0, 2.0, f64::NEG_INFINITY]).unwrap_err();
-        assert_eq!(err.to_string(), "weight 2 of hidden neuron 0 is not finite (-inf)");
-        assert_eq!(net.neuron(0), &[1.0, -1.0, 2.0]);
+    }
+
+    #[test]
+    #[should_panic(expected = "one gene set per hidden neuron")]
+    fn copy_neurons_needs_every_neuron() {
+        let mut net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
+        net.copy_neurons([&[7.0, 8.0, 9.0][..]]);
     }
 
     #[test]

@@ -1,12 +1,13 @@
 //! Enforced Sub-Populations (Gomez & Miikkulainen), with Høverstad's
 //! modifications as switches (`algorithms.md` §1-2).
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use rand::seq::SliceRandom;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-use super::operators::{cauchy, crossover, mutate_one_gene, random_genes};
+use super::operators::{cauchy, crossover, mutate_one_gene};
+use super::subpop::Subpop;
 use super::{
     best_of, check_count, check_init_range, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
 };
@@ -158,8 +159,8 @@ pub struct Esp {
 struct State {
     inputs: usize,
     outputs: usize,
-    /// `subpops[i][k]`: neuron k of sub-population i (its genes).
-    subpops: Vec<Vec<Vec<f64>>>,
+    /// The sub-populations, one per hidden neuron.
+    subpops: Vec<Subpop>,
     /// The search's best network and its fitness (what burst mutation builds on).
     best: Option<(Network, f64)>,
     champion: Option<Champion>,
@@ -176,7 +177,7 @@ struct State {
 
 impl State {
     /// The state before the first generation.
-    fn new(inputs: usize, outputs: usize, subpops: Vec<Vec<Vec<f64>>>) -> State {
+    fn new(inputs: usize, outputs: usize, subpops: Vec<Subpop>) -> State {
         State {
             inputs,
             outputs,
@@ -205,10 +206,18 @@ impl State {
             )?;
             self.networks = vec![blank; picks.count()];
         }
-        for (network, pick) in self.networks.iter_mut().zip(picks.networks()) {
-            for (i, (&k, subpop)) in pick.iter().zip(&self.subpops).enumerate() {
-                network.set_neuron(i, &subpop[k])?;
+        // Checked here once, so that the copies need no check.
+        for (i, subpop) in self.subpops.iter().enumerate() {
+            if let Some((k, gene)) = subpop.first_non_finite() {
+                bail!(
+                    "weight {gene} of neuron {k} of sub-population {i} is not finite ({}): \
+                     the mutation settings let the weights overflow",
+                    subpop.neuron(k)[gene]
+                );
             }
+        }
+        for (network, pick) in self.networks.iter_mut().zip(picks.networks()) {
+            network.copy_neurons(pick.iter().zip(&self.subpops).map(|(&k, subpop)| subpop.neuron(k)));
         }
         Ok(&self.networks)
     }
@@ -232,11 +241,6 @@ impl Picks {
     fn networks(&self) -> std::slice::ChunksExact<'_, usize> {
         self.flat.chunks_exact(self.subpops)
     }
-}
-
-/// A sub-population of `size` random neurons of `genes` genes.
-fn random_subpop(rng: &mut crate::rng::Stream, size: usize, genes: usize, range: f64) -> Vec<Vec<f64>> {
-    (0..size).map(|_| random_genes(rng, genes, range)).collect()
 }
 
 impl Esp {
@@ -263,7 +267,7 @@ impl Esp {
         let genes = inputs + outputs;
         let mut rng = stream(self.seed, &[purpose::INIT]);
         let subpops = (0..s.initial_hidden)
-            .map(|_| random_subpop(&mut rng, s.subpop_size, genes, s.init_range))
+            .map(|_| Subpop::random(&mut rng, s.subpop_size, genes, s.init_range))
             .collect();
         let mut state = State::new(inputs, outputs, subpops);
         let mut records = Vec::with_capacity(s.generations);
@@ -399,18 +403,18 @@ impl Esp {
                 .collect();
             let mut order: Vec<usize> = (0..n).collect();
             order.sort_by(|&a, &b| credit[b].total_cmp(&credit[a]));
-            *subpop = order.into_iter().map(|k| std::mem::take(&mut subpop[k])).collect();
+            subpop.reorder(&order);
         }
     }
 
     /// Crossover of the top quarter into the bottom half, then mutation of
     /// the children (`subpop` sorted best first).
-    fn recombine(&self, subpop: &mut [Vec<f64>], generation: usize, index: usize) {
+    fn recombine(&self, subpop: &mut Subpop, generation: usize, index: usize) {
         let s = &self.settings;
         let n = subpop.len();
         let breeders = n / 4;
         let mut rng = stream(self.seed, &[purpose::BREED, generation as u64, index as u64]);
-        let genes = subpop[0].len();
+        let genes = subpop.genes_per_neuron();
         let (mut first, mut second) = (vec![0.0; genes], vec![0.0; genes]);
         for i in 0..breeders {
             // The best mates with any of the top quarter, the others with a higher-ranked one.
@@ -419,12 +423,13 @@ impl Esp {
             } else {
                 rng.random_range(0..i)
             };
-            crossover(&mut rng, &subpop[i], &subpop[mate], &mut first, &mut second);
-            subpop[n - 1 - 2 * i].copy_from_slice(&first);
-            subpop[n - 2 - 2 * i].copy_from_slice(&second);
+            crossover(&mut rng, subpop.neuron(i), subpop.neuron(mate), &mut first, &mut second);
+            subpop.neuron_mut(n - 1 - 2 * i).copy_from_slice(&first);
+            subpop.neuron_mut(n - 2 - 2 * i).copy_from_slice(&second);
         }
-        for child in &mut subpop[n - 2 * breeders..] {
-            mutate_one_gene(&mut rng, child, s.mutation_rate, s.mutation_scale, s.cauchy_limit);
+        for child in n - 2 * breeders..n {
+            let genes = subpop.neuron_mut(child);
+            mutate_one_gene(&mut rng, genes, s.mutation_rate, s.mutation_scale, s.cauchy_limit);
         }
     }
 
@@ -481,16 +486,15 @@ impl Esp {
     }
 
     /// A sub-population of copies of `neuron`, Cauchy noise on every gene.
-    fn around(&self, neuron: &[f64], rng: &mut crate::rng::Stream) -> Vec<Vec<f64>> {
+    fn around(&self, neuron: &[f64], rng: &mut crate::rng::Stream) -> Subpop {
         let s = &self.settings;
-        (0..s.subpop_size)
-            .map(|_| {
-                neuron
-                    .iter()
-                    .map(|w| w + cauchy(rng, s.burst_scale, s.cauchy_limit))
-                    .collect()
-            })
-            .collect()
+        let copies = (0..s.subpop_size).map(|_| {
+            neuron
+                .iter()
+                .map(|w| w + cauchy(rng, s.burst_scale, s.cauchy_limit))
+                .collect::<Vec<f64>>()
+        });
+        Subpop::from_neurons(neuron.len(), copies)
     }
 
     /// Evaluates the best network whole and with each hidden neuron
@@ -530,7 +534,7 @@ impl Esp {
                 let genes = state.inputs + state.outputs;
                 state
                     .subpops
-                    .push(random_subpop(&mut rng, s.subpop_size, genes, s.init_range));
+                    .push(Subpop::random(&mut rng, s.subpop_size, genes, s.init_range));
             }
             LesionOutcome::Remove { neuron } => {
                 state.subpops.remove(neuron);
@@ -562,7 +566,7 @@ mod tests {
     fn state(e: &Esp, hidden: usize) -> State {
         let mut rng = stream(5, &[]);
         let subpops = (0..hidden)
-            .map(|_| random_subpop(&mut rng, e.settings.subpop_size, 3, 6.0))
+            .map(|_| Subpop::random(&mut rng, e.settings.subpop_size, 3, 6.0))
             .collect();
         State::new(2, 1, subpops)
     }
@@ -575,13 +579,13 @@ mod tests {
             ..EspSettings::default()
         });
         // Neuron k's genes all equal k: a child's genes show its parents.
-        let mut subpop: Vec<Vec<f64>> = (0..12).map(|k| vec![k as f64; 5]).collect();
+        let mut subpop = Subpop::from_neurons(5, (0..12).map(|k| [k as f64; 5]));
         e.recombine(&mut subpop, 1, 0);
-        for (k, neuron) in subpop.iter().enumerate().take(6) {
-            assert_eq!(*neuron, vec![k as f64; 5], "the top half survives unchanged");
+        for (k, neuron) in subpop.neurons().enumerate().take(6) {
+            assert_eq!(neuron, [k as f64; 5], "the top half survives unchanged");
         }
         for j in 0..3 {
-            let (first, second) = (&subpop[11 - 2 * j], &subpop[10 - 2 * j]);
+            let (first, second) = (subpop.neuron(11 - 2 * j), subpop.neuron(10 - 2 * j));
             // One-point crossover: the first child starts with parent j's
             // genes up to the cut, the second with the mate's; the mate is
             // higher ranked (or, for the best, any of the top quarter).
@@ -607,10 +611,10 @@ mod tests {
         let mut mutated = 0;
         for generation in 0..200 {
             // All neurons identical: crossover changes nothing, so any change is a mutation.
-            let mut subpop = vec![vec![1.0; 11]; 40];
+            let mut subpop = Subpop::from_neurons(11, vec![[1.0; 11]; 40]);
             e.recombine(&mut subpop, generation, 0);
-            assert!(subpop[..20].iter().all(|n| *n == vec![1.0; 11]));
-            for child in &subpop[20..] {
+            assert!(subpop.neurons().take(20).all(|n| n == [1.0; 11]));
+            for child in subpop.neurons().skip(20) {
                 let changed = child.iter().filter(|g| **g != 1.0).count();
                 assert!(changed <= 1, "one gene at most");
                 mutated += changed;
@@ -650,7 +654,7 @@ mod tests {
                 ..EspSettings::default()
             });
             let mut st = state(&e, 1);
-            st.subpops[0] = (0..4).map(|k| vec![k as f64; 3]).collect();
+            st.subpops[0] = Subpop::from_neurons(3, (0..4).map(|k| [k as f64; 3]));
             // Neuron 1: fitness 9 and 0 (mean 4.5, max 9); neuron 2: 5 and 5 (mean 5, max 5);
             // neuron 0: 1; neuron 3: in no network (0).
             let picks = Picks {
@@ -658,10 +662,37 @@ mod tests {
                 flat: vec![1, 1, 2, 2, 0],
             };
             e.assign_credit(&mut st, &picks, &[9.0, 0.0, 5.0, 5.0, 1.0]);
-            let order: Vec<f64> = st.subpops[0].iter().map(|n| n[0]).collect();
+            let order: Vec<f64> = st.subpops[0].neurons().map(|n| n[0]).collect();
             assert_eq!(order[0], expected_best as f64, "{credit:?}: {order:?}");
             assert_eq!(order[3], 3.0, "{credit:?}: the unevaluated neuron ranks last");
         }
+    }
+
+    #[test]
+    fn assembly_copies_the_picked_neurons_and_refuses_a_non_finite_weight() {
+        let e = esp(EspSettings {
+            subpop_size: 4,
+            ..EspSettings::default()
+        });
+        let mut st = state(&e, 2);
+        let picks = Picks {
+            subpops: 2,
+            flat: vec![3, 0, 1, 2],
+        };
+        let subpops = st.subpops.clone();
+        let networks = st.assemble(&picks).unwrap();
+        assert_eq!(networks.len(), 2);
+        for (network, pick) in networks.iter().zip(picks.networks()) {
+            assert_eq!(network.neuron(0), subpops[0].neuron(pick[0]));
+            assert_eq!(network.neuron(1), subpops[1].neuron(pick[1]));
+        }
+        // Any weight of any sub-population, picked or not, is checked.
+        st.subpops[1].neuron_mut(3)[2] = f64::INFINITY;
+        let err = st.assemble(&picks).unwrap_err().to_string();
+        assert!(
+            err.starts_with("weight 2 of neuron 3 of sub-population 1 is not finite (inf)"),
+            "{err}"
+        );
     }
 
     /// Fitness 1 for a whole network, 0 with any neuron lesioned: never improves after the first generation.
@@ -690,7 +721,7 @@ mod tests {
         assert_eq!(st.bursts, 1);
         for (k, subpop) in st.subpops.iter().enumerate() {
             let mut deltas: Vec<f64> = subpop
-                .iter()
+                .neurons()
                 .flat_map(|n| n.iter().zip(best.neuron(k)).map(|(a, b)| (a - b).abs()))
                 .collect();
             assert!(

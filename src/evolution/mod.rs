@@ -30,6 +30,7 @@ mod evaluator;
 mod hill_climb;
 pub mod operators;
 mod record;
+mod subpop;
 
 pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, TopologyMode};
 pub use evaluator::{evaluate_all, Evaluator, FnEvaluator};
