@@ -100,7 +100,10 @@ fn configuration_files_override_settings_and_reject_bad_keys_and_values() {
         ("[esp]\nsubpop_size = -3\n", "subpop_size"),
         ("[esp]\nmutation_rate = 1.5\n", "esp.mutation_rate"),
         ("[hill_climb]\np_flip = -0.1\n", "hill_climb.p_flip"),
-        ("[esp]\ninit_range = 1e308\n", "esp.init_range must be at most"),
+        (
+            "[esp]\ninit_range = 1e308\n",
+            "esp.init_range must be at most 8.988465674311579e307, so that (-esp.init_range, esp.init_range) has a finite width, got 1e308",
+        ),
         (
             "[hill_climb]\ninit_range = 1e308\n",
             "hill_climb.init_range must be at most",

@@ -83,7 +83,7 @@ pub(crate) fn check_init_range(name: &str, v: f64) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!(
-            "{name} must be at most {:e}, so that (-{name}, {name}) has a finite width, got {v}",
+            "{name} must be at most {:e}, so that (-{name}, {name}) has a finite width, got {v:e}",
             f64::MAX / 2.0
         ))
     }
