@@ -211,7 +211,7 @@ impl State {
             if let Some((k, gene)) = subpop.first_non_finite() {
                 bail!(
                     "weight {gene} of neuron {k} of sub-population {i} is not finite ({}): \
-                     the mutation settings let the weights overflow",
+                     the mutation and burst settings let the weights overflow",
                     subpop.neuron(k)[gene]
                 );
             }
