@@ -1,6 +1,7 @@
 //! A sub-population of ESP: neurons of equal length stored neuron after
-//! neuron in one array, so that assembling a generation's networks reads
-//! contiguous memory instead of one allocation per neuron.
+//! neuron in one array, so that the whole sub-population is checked for
+//! non-finite weights in one vectorised pass per generation and the
+//! networks assembled from it need no check of their own.
 
 use super::operators::random_genes;
 use crate::rng::Stream;
