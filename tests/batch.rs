@@ -6,7 +6,7 @@
 use psa_esp::network::Network;
 use psa_esp::numeric::SimdLevel;
 use psa_esp::physics::BackendKind;
-use psa_esp::psa::batch::LANES;
+use psa_esp::psa::batch::{LANES, NARROW_LANES};
 use psa_esp::psa::{BatchRunner, FitnessKind, NoiseSettings, PsaSettings, Task, TrialRunner};
 use psa_esp::rng::{stream, Stream};
 use rand::RngExt;
@@ -133,9 +133,12 @@ fn every_simd_level_computes_the_same_bits_the_portable_fallback_included() {
 fn a_partial_block_and_a_single_network_give_the_same_fitness_as_a_full_block() {
     let settings = native(PsaSettings::default());
     let runner = BatchRunner::new(&settings, Task::StopRotation).unwrap();
-    let networks: Vec<Network> = (0..LANES as u64 + 3).map(random_network).collect();
+    // A full wide block, then a padded wide one (more than NARROW_LANES
+    // left); alone, each network flies in a padded narrow block.
+    let count = (LANES + NARROW_LANES + 5) as u64;
+    let networks: Vec<Network> = (0..count).map(random_network).collect();
     let refs: Vec<&Network> = networks.iter().collect();
-    let all = runner.evaluate(&refs, &mut streams(0..LANES as u64 + 3)).unwrap();
+    let all = runner.evaluate(&refs, &mut streams(0..count)).unwrap();
     for (i, network) in networks.iter().enumerate() {
         let alone = runner.evaluate(&[network], &mut [stream(i as u64, &[2])]).unwrap();
         assert_eq!(alone[0].to_bits(), all[i].to_bits(), "network {i}");

@@ -36,8 +36,11 @@ use crate::rng::Stream;
 /// registers per value, enough independent work to hide the latency of the
 /// long dependency chain of one step.
 pub const LANES: usize = 32;
-/// The kernel's width for the last few networks of a batch.
-pub const NARROW_LANES: usize = 8;
+/// The kernel's width for the last few networks of a batch (at most this
+/// many): two AVX-512 registers per value. On the baseline ESP's 400
+/// networks a generation (12 wide blocks and 16 left), measured 6 % faster
+/// overall than 8 lanes.
+pub const NARROW_LANES: usize = 16;
 
 /// The weights of a block of networks, lane by lane. Lesioned hidden
 /// neurons, and the missing neurons of networks smaller than the block's
@@ -336,8 +339,8 @@ impl BatchRunner {
         let mut start = 0;
         while start < networks.len() {
             let left = networks.len() - start;
-            // Full wide blocks; a remainder of up to 16 goes in narrow blocks.
-            let width = if left > 2 * NARROW_LANES { LANES } else { NARROW_LANES };
+            // Full wide blocks; a remainder that fits one goes in a narrow block.
+            let width = if left > NARROW_LANES { LANES } else { NARROW_LANES };
             let end = start + left.min(width);
             let (block, streams) = (&networks[start..end], &mut rngs[start..end]);
             if width == LANES {
