@@ -384,24 +384,33 @@ impl Esp {
     /// then each sub-population sorted best first (stable).
     fn assign_credit(&self, state: &mut State, picks: &Picks, fitness: &[f64]) {
         let n = self.settings.subpop_size;
-        for (i, subpop) in state.subpops.iter_mut().enumerate() {
-            let mut sum = vec![0.0; n];
-            let mut count = vec![0usize; n];
-            let mut max = vec![f64::NEG_INFINITY; n];
-            for (pick, &f) in picks.networks().zip(fitness) {
-                let k = pick[i];
-                sum[k] += f;
-                count[k] += 1;
-                max[k] = max[k].max(f);
+        // Neuron k of sub-population i at index i n + k; one pass over the
+        // networks, each neuron's sum in network order.
+        let neurons = n * state.subpops.len();
+        let (mut sum, mut count, mut max) = (
+            vec![0.0; neurons],
+            vec![0usize; neurons],
+            vec![f64::NEG_INFINITY; neurons],
+        );
+        for (pick, &f) in picks.networks().zip(fitness) {
+            for (i, &k) in pick.iter().enumerate() {
+                let j = i * n + k;
+                sum[j] += f;
+                count[j] += 1;
+                max[j] = max[j].max(f);
             }
-            let credit: Vec<f64> = (0..n)
-                .map(|k| match (count[k], self.settings.credit) {
-                    (0, _) => 0.0,
-                    (c, Credit::Mean) => sum[k] / c as f64,
-                    (_, Credit::Max) => max[k],
-                })
-                .collect();
-            let mut order: Vec<usize> = (0..n).collect();
+        }
+        let credit: Vec<f64> = (0..neurons)
+            .map(|j| match (count[j], self.settings.credit) {
+                (0, _) => 0.0,
+                (c, Credit::Mean) => sum[j] / c as f64,
+                (_, Credit::Max) => max[j],
+            })
+            .collect();
+        let mut order = Vec::with_capacity(n);
+        for (subpop, credit) in state.subpops.iter_mut().zip(credit.chunks_exact(n)) {
+            order.clear();
+            order.extend(0..n);
             order.sort_by(|&a, &b| credit[b].total_cmp(&credit[a]));
             subpop.reorder(&order);
         }
