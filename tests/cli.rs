@@ -120,7 +120,16 @@ fn crosscheck_reports_every_backend_against_ode() {
 
 #[test]
 fn bench_prints_ns_per_step_for_every_backend_and_the_logistic_share() {
-    let o = psa_esp(&["bench", "--steps", "1000", "--rounds", "1", "--json"]);
+    let o = psa_esp(&[
+        "bench",
+        "--steps",
+        "1000",
+        "--rounds",
+        "1",
+        "--generations",
+        "10",
+        "--json",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let rows = report["physics_step"].as_array().unwrap();

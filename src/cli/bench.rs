@@ -38,8 +38,9 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..))]
     pub networks: u64,
     /// Generations of the `evolve` and `replicate` scaling runs (5 times
-    /// as many for the algorithm overhead).
-    #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u64).range(2..))]
+    /// as many for the algorithm overhead). Fewer make runs of a few
+    /// hundredths of a second, whose speed-ups scatter.
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(2..))]
     pub generations: u64,
     /// Print the results as JSON.
     #[arg(long)]
