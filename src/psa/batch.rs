@@ -85,8 +85,8 @@ struct Flight<'a, const N: usize> {
 /// that the noise code costs noiseless flights nothing). Returns the points
 /// and which lanes ended with a finite velocity and spin. `N2` is `2 N` to
 /// evaluate the neurons two at a time with [`sigmoid_pair`], `N` to evaluate
-/// them one by one (measured on Zen 5: pairs are faster with AVX-512's 32
-/// wide registers, slower with AVX2's 16).
+/// them one by one (measured on Zen 5: pairs are faster on AVX-512 and
+/// slower on AVX2, which has half as many registers).
 ///
 /// A lane whose thrust turned NaN is always among those that did not: a NaN
 /// command makes its thruster's world-frame force NaN (`PlanarBody` keeps
