@@ -97,16 +97,17 @@ fn psa_evaluation(c: &mut Criterion) {
         backend: BackendKind::Native,
         ..PsaSettings::default()
     };
-    let refs: Vec<&Network> = networks.iter().collect();
-    group.throughput(criterion::Throughput::Elements(refs.len() as u64));
+    group.throughput(criterion::Throughput::Elements(networks.len() as u64));
     for level in SimdLevel::ALL.into_iter().filter(|l| l.is_supported()) {
         let runner = BatchRunner::new(&settings, Task::StopRotation)
             .expect("runner")
             .with_level(level);
         group.bench_function(format!("native batched {level} (32 networks)"), |b| {
             b.iter(|| {
-                let mut rngs: Vec<_> = (0..refs.len()).map(|_| psa_esp::rng::stream(0, &[])).collect();
-                runner.evaluate(&refs, &mut rngs).expect("evaluate")
+                let mut rngs: Vec<_> = (0..networks.len()).map(|_| psa_esp::rng::stream(0, &[])).collect();
+                runner
+                    .evaluate(&networks, 0..networks.len(), &mut rngs)
+                    .expect("evaluate")
             })
         });
     }

@@ -6,6 +6,8 @@
 //! PSA's 7-H-4 network). Outputs are logistic too, with no separate bias.
 //! A lesioned hidden neuron contributes nothing to the outputs.
 
+use std::borrow::{Borrow, Cow};
+
 use thiserror::Error;
 
 /// Errors building a network.
@@ -55,6 +57,74 @@ fn check_sizes(inputs: usize, outputs: usize) -> Result<(), NetworkError> {
         )));
     }
     Ok(())
+}
+
+/// Networks read in place, neuron by neuron: a slice of [`Network`]s, or
+/// ESP's sub-populations with the picks that form a generation's networks
+/// from them, which an evaluator reads without a copy of each network
+/// being made first.
+pub trait NetworkSet: Sync {
+    /// The number of networks.
+    fn len(&self) -> usize;
+    /// Whether there is none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Network `j`'s inputs (the bias input included) and outputs.
+    fn shape(&self, j: usize) -> (usize, usize);
+    /// Network `j`'s number of hidden neurons.
+    fn hidden(&self, j: usize) -> usize;
+    /// The genes of hidden neuron `k` of network `j`: input weights, then
+    /// output weights.
+    fn neuron(&self, j: usize, k: usize) -> &[f64];
+    /// Whether hidden neuron `k` of network `j` is switched off.
+    fn is_lesioned(&self, j: usize, k: usize) -> bool;
+    /// Network `j` whole: borrowed from a set that stores it, assembled
+    /// from any other.
+    fn network(&self, j: usize) -> Cow<'_, Network>;
+}
+
+impl<N: Borrow<Network> + Sync> NetworkSet for [N] {
+    fn len(&self) -> usize {
+        <[N]>::len(self)
+    }
+    fn shape(&self, j: usize) -> (usize, usize) {
+        let network = self[j].borrow();
+        (network.inputs, network.outputs)
+    }
+    fn hidden(&self, j: usize) -> usize {
+        self[j].borrow().hidden()
+    }
+    fn neuron(&self, j: usize, k: usize) -> &[f64] {
+        self[j].borrow().neuron(k)
+    }
+    fn is_lesioned(&self, j: usize, k: usize) -> bool {
+        self[j].borrow().is_lesioned(k)
+    }
+    fn network(&self, j: usize) -> Cow<'_, Network> {
+        Cow::Borrowed(self[j].borrow())
+    }
+}
+
+impl<N: Borrow<Network> + Sync> NetworkSet for Vec<N> {
+    fn len(&self) -> usize {
+        self.as_slice().len()
+    }
+    fn shape(&self, j: usize) -> (usize, usize) {
+        self.as_slice().shape(j)
+    }
+    fn hidden(&self, j: usize) -> usize {
+        self.as_slice().hidden(j)
+    }
+    fn neuron(&self, j: usize, k: usize) -> &[f64] {
+        self.as_slice().neuron(j, k)
+    }
+    fn is_lesioned(&self, j: usize, k: usize) -> bool {
+        self.as_slice().is_lesioned(j, k)
+    }
+    fn network(&self, j: usize) -> Cow<'_, Network> {
+        self.as_slice().network(j)
+    }
 }
 
 /// A 1-hidden-layer network; see the module docs for the gene layout.
@@ -137,30 +207,6 @@ impl Network {
         &self.genes[k * per..(k + 1) * per]
     }
 
-    /// Overwrites the hidden neurons, neuron k with the k-th slice of
-    /// `neurons` (input weights, then output weights), and switches every
-    /// lesioned neuron back on.
-    ///
-    /// This is ESP's assembly of each generation's networks, its hottest
-    /// path outside evaluation, so it does not check the weights: the
-    /// caller has checked that they are finite (ESP checks each
-    /// sub-population once per generation), and debug builds check again.
-    ///
-    /// # Panics
-    /// If a slice's length is not `inputs + outputs`, or there are fewer
-    /// slices than hidden neurons.
-    pub(crate) fn copy_neurons<'a>(&mut self, neurons: impl IntoIterator<Item = &'a [f64]>) {
-        let per = self.genes_per_neuron();
-        let mut copied = 0;
-        for (slot, genes) in self.genes.chunks_exact_mut(per).zip(neurons) {
-            slot.copy_from_slice(genes);
-            copied += 1;
-        }
-        assert_eq!(copied, self.hidden(), "one gene set per hidden neuron");
-        debug_assert!(all_finite(&self.genes), "non-finite weights copied into a network");
-        self.lesioned.fill(false);
-    }
-
     /// Switches hidden neuron `k` off (`true`) or on.
     pub fn set_lesioned(&mut self, k: usize, lesioned: bool) {
         self.lesioned[k] = lesioned;
@@ -234,22 +280,6 @@ mod tests {
         let mut out2 = [0.0];
         alone.activate(&[2.0, 1.0], &mut out2);
         assert_eq!(out, out2);
-    }
-
-    #[test]
-    fn copy_neurons_overwrites_every_neuron_and_clears_lesions() {
-        let mut net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
-        net.set_lesioned(1, true);
-        net.copy_neurons([&[7.0, 8.0, 9.0][..], &[4.0, 5.0, 6.0]]);
-        assert_eq!(net.genes(), &[7.0, 8.0, 9.0, 4.0, 5.0, 6.0]);
-        assert!(!net.is_lesioned(1));
-    }
-
-    #[test]
-    #[should_panic(expected = "one gene set per hidden neuron")]
-    fn copy_neurons_needs_every_neuron() {
-        let mut net = Network::from_neurons(2, 1, &[vec![1.0, -1.0, 2.0], vec![0.5, 0.0, -3.0]]).unwrap();
-        net.copy_neurons([&[7.0, 8.0, 9.0][..]]);
     }
 
     #[test]

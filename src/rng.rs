@@ -23,15 +23,44 @@ fn mix(mut z: u64) -> u64 {
 /// The stream for `seed` and the key path `key` (e.g. `[PURPOSE, generation,
 /// network, trial]`). Different keys give independent streams.
 pub fn stream(seed: u64, key: &[u64]) -> Stream {
-    let mut state = mix(seed);
-    for &k in key {
-        state = mix(state ^ mix(k));
-    }
+    from_state(key.iter().fold(mix(seed), |state, &k| step(state, k)))
+}
+
+/// The key state after one more key element.
+fn step(state: u64, k: u64) -> u64 {
+    mix(state ^ mix(k))
+}
+
+/// The stream of a final key state.
+fn from_state(state: u64) -> Stream {
     let mut bytes = [0u8; 32];
     for (chunk, word) in bytes.chunks_mut(8).zip(expand(state)) {
         chunk.copy_from_slice(&word.to_le_bytes());
     }
     ChaCha8Rng::from_seed(bytes)
+}
+
+/// The streams `stream(seed, [key.., j])` of every index `j`, with the
+/// common part of their keys hashed once: how the algorithms hand an
+/// evaluator the streams of a call's networks, which it makes as it needs
+/// them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StreamFamily {
+    state: u64,
+}
+
+impl StreamFamily {
+    /// The family of `seed` and the key prefix `key`.
+    pub fn new(seed: u64, key: &[u64]) -> StreamFamily {
+        StreamFamily {
+            state: key.iter().fold(mix(seed), |state, &k| step(state, k)),
+        }
+    }
+
+    /// Member `j`: `stream(seed, [key.., j])`.
+    pub fn stream(&self, j: usize) -> Stream {
+        from_state(step(self.state, j as u64))
+    }
 }
 
 /// Four well-mixed words from one (never all zero, as `mix` is a bijection
@@ -53,5 +82,14 @@ mod tests {
         assert_ne!(draw(1, &[2, 3]), draw(1, &[3, 2]));
         assert_ne!(draw(1, &[2, 3]), draw(1, &[2, 3, 0]));
         assert_ne!(draw(1, &[]), draw(1, &[0]));
+    }
+
+    #[test]
+    fn a_family_member_is_the_stream_of_the_whole_key() {
+        let family = StreamFamily::new(9, &[3, 4]);
+        for j in [0, 1, 399, usize::MAX] {
+            assert_eq!(family.stream(j), stream(9, &[3, 4, j as u64]));
+        }
+        assert_eq!(StreamFamily::new(9, &[]).stream(5), stream(9, &[5]));
     }
 }

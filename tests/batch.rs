@@ -55,7 +55,7 @@ fn both_paths(
     let batched = BatchRunner::new(settings, task)
         .unwrap()
         .with_level(level)
-        .evaluate(&refs, &mut streams(seeds))
+        .evaluate(&refs, 0..refs.len(), &mut streams(seeds))
         .unwrap();
     (scalar, batched)
 }
@@ -130,7 +130,7 @@ fn every_simd_level_computes_the_same_bits_the_portable_fallback_included() {
 }
 
 #[test]
-fn a_partial_block_and_a_single_network_give_the_same_fitness_as_a_full_block() {
+fn a_partial_block_a_range_and_a_single_network_give_the_same_fitness_as_a_full_block() {
     let settings = native(PsaSettings::default());
     let runner = BatchRunner::new(&settings, Task::StopRotation).unwrap();
     // A full wide block, then a padded wide one (more than NARROW_LANES
@@ -138,11 +138,29 @@ fn a_partial_block_and_a_single_network_give_the_same_fitness_as_a_full_block() 
     let count = (LANES + NARROW_LANES + 5) as u64;
     let networks: Vec<Network> = (0..count).map(random_network).collect();
     let refs: Vec<&Network> = networks.iter().collect();
-    let all = runner.evaluate(&refs, &mut streams(0..count)).unwrap();
+    let all = runner.evaluate(&refs, 0..refs.len(), &mut streams(0..count)).unwrap();
     for (i, network) in networks.iter().enumerate() {
-        let alone = runner.evaluate(&[network], &mut [stream(i as u64, &[2])]).unwrap();
+        let alone = runner
+            .evaluate(&[network][..], 0..1, &mut [stream(i as u64, &[2])])
+            .unwrap();
         assert_eq!(alone[0].to_bits(), all[i].to_bits(), "network {i}");
+        // The same network as a one-network range of the whole set.
+        let in_place = runner
+            .evaluate(&networks, i..i + 1, &mut [stream(i as u64, &[2])])
+            .unwrap();
+        assert_eq!(in_place[0].to_bits(), all[i].to_bits(), "network {i} in place");
     }
+    // A range that starts mid-set and spans a wide and a narrow block.
+    let range = 3..LANES + 9;
+    let part = runner
+        .evaluate(
+            &networks,
+            range.clone(),
+            &mut streams(range.start as u64..range.end as u64),
+        )
+        .unwrap();
+    let bits = |f: &[f64]| f.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&part), bits(&all[range]));
 }
 
 #[test]
@@ -165,7 +183,7 @@ fn a_network_whose_thrust_turns_nan_gets_the_scalar_paths_error() {
             .unwrap_err();
         let batched = BatchRunner::new(&settings, Task::StopAtPosition)
             .unwrap()
-            .evaluate(&[&good, &bad], &mut [stream(1, &[]), stream(0, &[])])
+            .evaluate(&[&good, &bad][..], 0..2, &mut [stream(1, &[]), stream(0, &[])])
             .unwrap_err();
         assert_eq!(batched.to_string(), scalar.to_string());
         assert!(scalar.to_string().contains("thrust"), "{scalar}");
@@ -178,7 +196,7 @@ fn the_batched_path_refuses_other_backends_and_bad_networks() {
     assert!(err.to_string().contains("native"), "{err}");
     let runner = BatchRunner::new(&native(PsaSettings::default()), Task::Turn).unwrap();
     let wrong = Network::from_genes(3, 4, vec![0.0; 7]).unwrap();
-    let err = runner.evaluate(&[&wrong], &mut [stream(0, &[])]).unwrap_err();
+    let err = runner.evaluate(&[&wrong][..], 0..1, &mut [stream(0, &[])]).unwrap_err();
     assert!(err.to_string().contains("needs 7"), "{err}");
 }
 

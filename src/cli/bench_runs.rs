@@ -2,6 +2,7 @@
 //! 2 threads, and the share of a generation's time that is not network
 //! evaluation (sorting, recombination, mutation, bookkeeping, records).
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -12,10 +13,10 @@ use crate::evolution::{Esp, Evaluator};
 use crate::experiment::grid::{GridPreset, GridSpec};
 use crate::experiment::replicate::{replicate, FinishedRun, GridProgress};
 use crate::experiment::{GridConfig, Preset, PsaEvaluator, RunConfig};
-use crate::network::Network;
+use crate::network::{Network, NetworkSet};
 use crate::physics::BackendKind;
 use crate::psa::Task;
-use crate::rng::Stream;
+use crate::rng::{Stream, StreamFamily};
 
 /// A whole-run workload timed on 1 and on 2 threads.
 #[derive(Debug, Serialize)]
@@ -173,13 +174,14 @@ impl Evaluator for Timed<'_> {
     fn batch_size(&self) -> usize {
         self.inner.batch_size()
     }
-    fn evaluate_batch(
+    fn evaluate_batch<S: NetworkSet + ?Sized>(
         &self,
         worker: &mut Self::Worker,
-        networks: &[&Network],
-        rngs: &mut [Stream],
+        networks: &S,
+        range: Range<usize>,
+        streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
-        self.time(|| self.inner.evaluate_batch(worker, networks, rngs))
+        self.time(|| self.inner.evaluate_batch(worker, networks, range, streams))
     }
 }
 

@@ -1,6 +1,8 @@
 //! Enforced Sub-Populations (Gomez & Miikkulainen), with Høverstad's
 //! modifications as switches (`algorithms.md` §1-2).
 
+use std::borrow::Cow;
+
 use anyhow::{anyhow, bail, Result};
 use rand::seq::SliceRandom;
 use rand::RngExt;
@@ -12,7 +14,7 @@ use super::{
     best_of, check_count, check_init_range, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
 };
 use super::{Champion, Evaluator, GenerationRecord, LesionOutcome, RunResult};
-use crate::network::Network;
+use crate::network::{Network, NetworkSet};
 use crate::rng::stream;
 
 /// How networks are formed from the sub-populations.
@@ -170,9 +172,6 @@ struct State {
     pending: Option<LesionOutcome>,
     bursts: usize,
     evaluations: u64,
-    /// The networks of the last generation, reused so that a generation
-    /// allocates no network (their genes are overwritten).
-    networks: Vec<Network>,
 }
 
 impl State {
@@ -189,24 +188,14 @@ impl State {
             pending: None,
             bursts: 0,
             evaluations: 0,
-            networks: Vec::new(),
         }
     }
 
-    /// The networks `picks` assemble (pick[i]: the neuron taken from
-    /// sub-population i), written over the last generation's networks.
-    fn assemble(&mut self, picks: &Picks) -> Result<&[Network]> {
-        let hidden = self.subpops.len();
-        let reusable = self.networks.first().is_some_and(|n| n.hidden() == hidden);
-        if !reusable || self.networks.len() != picks.count() {
-            let blank = Network::from_genes(
-                self.inputs,
-                self.outputs,
-                vec![0.0; hidden * (self.inputs + self.outputs)],
-            )?;
-            self.networks = vec![blank; picks.count()];
-        }
-        // Checked here once, so that the copies need no check.
+    /// The networks `picks` form (pick[i]: the neuron taken from
+    /// sub-population i), read in place from the sub-populations; fails
+    /// if any weight of any sub-population is not finite.
+    fn networks<'a>(&'a self, picks: &'a Picks) -> Result<Assembled<'a>> {
+        // Checked here once, so that the networks' neurons need no check.
         for (i, subpop) in self.subpops.iter().enumerate() {
             if let Some((k, gene)) = subpop.first_non_finite() {
                 bail!(
@@ -216,10 +205,49 @@ impl State {
                 );
             }
         }
-        for (network, pick) in self.networks.iter_mut().zip(picks.networks()) {
-            network.copy_neurons(pick.iter().zip(&self.subpops).map(|(&k, subpop)| subpop.neuron(k)));
-        }
-        Ok(&self.networks)
+        Ok(Assembled {
+            inputs: self.inputs,
+            outputs: self.outputs,
+            subpops: &self.subpops,
+            picks,
+        })
+    }
+}
+
+/// A generation's networks as its sub-populations and picks: what the
+/// evaluator reads, neuron by neuron, without a copy of each network.
+struct Assembled<'a> {
+    inputs: usize,
+    outputs: usize,
+    subpops: &'a [Subpop],
+    picks: &'a Picks,
+}
+
+impl NetworkSet for Assembled<'_> {
+    fn len(&self) -> usize {
+        self.picks.count()
+    }
+    fn shape(&self, _: usize) -> (usize, usize) {
+        (self.inputs, self.outputs)
+    }
+    fn hidden(&self, _: usize) -> usize {
+        self.subpops.len()
+    }
+    fn neuron(&self, j: usize, k: usize) -> &[f64] {
+        self.subpops[k].neuron(self.picks.flat[j * self.picks.subpops + k])
+    }
+    fn is_lesioned(&self, _: usize, _: usize) -> bool {
+        false
+    }
+    fn network(&self, j: usize) -> Cow<'_, Network> {
+        let genes = (0..self.subpops.len())
+            .flat_map(|k| self.neuron(j, k))
+            .copied()
+            .collect();
+        Cow::Owned(
+            Network::from_genes(self.inputs, self.outputs, genes)
+                .expect("the sub-populations' weights were checked finite and their shape fits"),
+        )
     }
 }
 
@@ -315,36 +343,39 @@ impl Esp {
         generation: usize,
     ) -> Result<GenerationRecord> {
         let picks = self.sample(generation, state.subpops.len());
-        let networks = state.assemble(&picks)?;
-        let fitness = evaluate_all(evaluator, networks, self.seed, &[purpose::EVALUATE, generation as u64])?;
-        self.conclude(evaluator, state, &picks, fitness, generation)
+        let networks = state.networks(&picks)?;
+        let fitness = evaluate_all(evaluator, &networks, self.seed, &[purpose::EVALUATE, generation as u64])?;
+        let (top, top_fitness) = best_of(&fitness);
+        let top = networks.network(top).into_owned();
+        self.conclude(evaluator, state, &picks, fitness, (top, top_fitness), generation)
     }
 
-    /// The generation after its evaluation: champion and best, then burst
-    /// mutation or credit and recombination; returns its record.
+    /// The generation after its evaluation, given its best network and
+    /// that network's fitness: champion and best, then burst mutation or
+    /// credit and recombination; returns its record.
     fn conclude<E: Evaluator>(
         &self,
         evaluator: &E,
         state: &mut State,
         picks: &Picks,
         fitness: Vec<f64>,
+        (top, top_fitness): (Network, f64),
         generation: usize,
     ) -> Result<GenerationRecord> {
         let s = &self.settings;
         state.evaluations += picks.count() as u64;
 
         // The generation's best network updates the champion and the search's best.
-        let (top, top_fitness) = best_of(&fitness);
         if state.champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
             state.champion = Some(Champion {
-                network: state.networks[top].clone(),
+                network: top.clone(),
                 fitness: top_fitness,
                 generation,
             });
         }
         let improved = state.best.as_ref().is_none_or(|(_, f)| top_fitness > *f);
         if improved {
-            state.best = Some((state.networks[top].clone(), top_fitness));
+            state.best = Some((top, top_fitness));
             state.since_improvement = 0;
             state.bursts_since_improvement = 0;
             state.pending = None;
@@ -678,7 +709,7 @@ mod tests {
     }
 
     #[test]
-    fn assembly_copies_the_picked_neurons_and_refuses_a_non_finite_weight() {
+    fn assembly_reads_the_picked_neurons_and_refuses_a_non_finite_weight() {
         let e = esp(EspSettings {
             subpop_size: 4,
             ..EspSettings::default()
@@ -688,16 +719,20 @@ mod tests {
             subpops: 2,
             flat: vec![3, 0, 1, 2],
         };
-        let subpops = st.subpops.clone();
-        let networks = st.assemble(&picks).unwrap();
+        let networks = st.networks(&picks).unwrap();
         assert_eq!(networks.len(), 2);
-        for (network, pick) in networks.iter().zip(picks.networks()) {
-            assert_eq!(network.neuron(0), subpops[0].neuron(pick[0]));
-            assert_eq!(network.neuron(1), subpops[1].neuron(pick[1]));
+        for (j, pick) in picks.networks().enumerate() {
+            let network = networks.network(j);
+            for (k, &n) in pick.iter().enumerate() {
+                assert_eq!(networks.neuron(j, k), st.subpops[k].neuron(n));
+                assert_eq!(network.neuron(k), st.subpops[k].neuron(n));
+                assert!(!networks.is_lesioned(j, k) && !network.is_lesioned(k));
+            }
+            assert_eq!((networks.shape(j), networks.hidden(j)), ((2, 1), 2));
         }
         // Any weight of any sub-population, picked or not, is checked.
         st.subpops[1].neuron_mut(3)[2] = f64::INFINITY;
-        let err = st.assemble(&picks).unwrap_err().to_string();
+        let err = st.networks(&picks).map(|_| ()).unwrap_err().to_string();
         assert!(
             err.starts_with("weight 2 of neuron 3 of sub-population 1 is not finite (inf)"),
             "{err}"

@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, Result};
 use rayon::prelude::*;
 
-use crate::network::Network;
-use crate::rng::{stream, Stream};
+use crate::network::{Network, NetworkSet};
+use crate::rng::{Stream, StreamFamily};
 
 /// Scores networks. `Worker` is per-thread state (for the PSA: a physics
 /// world, which must stay on the thread that made it); the algorithms make
@@ -33,19 +33,21 @@ pub trait Evaluator: Sync {
         1
     }
 
-    /// The fitness of each network, network `i` with stream `rngs[i]`: what
-    /// [`Evaluator::evaluate`] gives each, bit for bit. The default calls it
-    /// network by network; a batched evaluator evaluates them in lockstep.
-    fn evaluate_batch(
+    /// The fitness of networks `range` of `networks`, network `j` with the
+    /// stream `streams.stream(j)`: what [`Evaluator::evaluate`] gives each,
+    /// bit for bit. The default calls it network by network; a batched
+    /// evaluator evaluates them in lockstep, reading their weights in place.
+    /// Making the streams is part of the evaluation: an evaluator that
+    /// draws nothing need not make them.
+    fn evaluate_batch<S: NetworkSet + ?Sized>(
         &self,
         worker: &mut Self::Worker,
-        networks: &[&Network],
-        rngs: &mut [Stream],
+        networks: &S,
+        range: Range<usize>,
+        streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
-        networks
-            .iter()
-            .zip(rngs)
-            .map(|(network, rng)| self.evaluate(worker, network, rng))
+        range
+            .map(|j| self.evaluate(worker, &networks.network(j), &mut streams.stream(j)))
             .collect()
     }
 }
@@ -97,35 +99,29 @@ where
 /// without going to sleep, and they stay awake until the next call), any
 /// other one network at a time. The result is in order and independent of
 /// the thread count and of the batching.
-pub fn evaluate_all<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64, key: &[u64]) -> Result<Vec<f64>> {
+pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    networks: &S,
+    seed: u64,
+    key: &[u64],
+) -> Result<Vec<f64>> {
+    let streams = StreamFamily::new(seed, key);
     if evaluator.batch_size() > 1 {
-        return evaluate_batches(evaluator, networks, seed, key);
+        return evaluate_batches(evaluator, networks, &streams);
     }
-    networks
-        .par_iter()
-        .enumerate()
+    (0..networks.len())
+        .into_par_iter()
         .map_init(
             || evaluator.worker().map_err(|e| format!("{e:#}")),
-            |worker, (j, network)| {
+            |worker, j| {
                 let worker = worker
                     .as_mut()
                     .map_err(|e| anyhow!("cannot set up an evaluation worker: {e}"))?;
-                let fitness = evaluator.evaluate(worker, network, &mut streams(seed, key, j..j + 1).remove(0))?;
+                let fitness = evaluator.evaluate(worker, &networks.network(j), &mut streams.stream(j))?;
                 check_fitness(&[fitness], j)?;
                 Ok(fitness)
             },
         )
-        .collect()
-}
-
-/// The streams of networks `range`: network `j`'s is keyed by `key` and `j`.
-fn streams(seed: u64, key: &[u64], range: Range<usize>) -> Vec<Stream> {
-    let mut full_key = [key, &[0]].concat();
-    range
-        .map(|j| {
-            *full_key.last_mut().expect("the key has the network index") = j as u64;
-            stream(seed, &full_key)
-        })
         .collect()
 }
 
@@ -165,8 +161,8 @@ fn batch_ranges(networks: usize, size: usize, threads: usize) -> Vec<Range<usize
 
 /// The batches of one [`evaluate_batches`] call, taken one at a time by
 /// whichever thread is free.
-struct Batches<'a> {
-    networks: &'a [Network],
+struct Batches<'a, S: ?Sized> {
+    networks: &'a S,
     ranges: Vec<Range<usize>>,
     /// The next batch to take.
     next: AtomicUsize,
@@ -186,9 +182,9 @@ impl Drop for CountDone<'_> {
     }
 }
 
-impl Batches<'_> {
+impl<S: NetworkSet + ?Sized> Batches<'_, S> {
     /// Takes and evaluates batches until none is left.
-    fn take_and_run<E: Evaluator>(&self, evaluator: &E, seed: u64, key: &[u64]) {
+    fn take_and_run<E: Evaluator>(&self, evaluator: &E, streams: &StreamFamily) {
         let mut worker = None;
         loop {
             let b = self.next.fetch_add(1, Ordering::AcqRel);
@@ -196,7 +192,7 @@ impl Batches<'_> {
                 return;
             };
             let _done = CountDone(&self.done);
-            let result = self.evaluate(evaluator, &mut worker, range.clone(), seed, key);
+            let result = self.evaluate(evaluator, &mut worker, range.clone(), streams);
             assert!(self.results[b].set(result).is_ok(), "each batch is taken once");
         }
     }
@@ -206,8 +202,7 @@ impl Batches<'_> {
         evaluator: &E,
         worker: &mut Option<E::Worker>,
         range: Range<usize>,
-        seed: u64,
-        key: &[u64],
+        streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
         let worker = match worker {
             Some(worker) => worker,
@@ -217,10 +212,9 @@ impl Batches<'_> {
                     .map_err(|e| anyhow!("cannot set up an evaluation worker: {e:#}"))?,
             ),
         };
-        let mut rngs = streams(seed, key, range.clone());
-        let refs: Vec<&Network> = self.networks[range.clone()].iter().collect();
-        let fitness = evaluator.evaluate_batch(worker, &refs, &mut rngs)?;
-        check_fitness(&fitness, range.start)?;
+        let start = range.start;
+        let fitness = evaluator.evaluate_batch(worker, self.networks, range, streams)?;
+        check_fitness(&fitness, start)?;
         Ok(fitness)
     }
 }
@@ -244,7 +238,11 @@ impl Batches<'_> {
 /// `evaluate_batch` must not wait on rayon itself (the evaluator's work is
 /// plain computation): a thread waits only for batches that other threads
 /// are evaluating.
-fn evaluate_batches<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64, key: &[u64]) -> Result<Vec<f64>> {
+fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    networks: &S,
+    streams: &StreamFamily,
+) -> Result<Vec<f64>> {
     BATCH_CALLS.fetch_add(1, Ordering::AcqRel);
     let threads = rayon::current_num_threads();
     let ranges = batch_ranges(networks.len(), evaluator.batch_size(), threads);
@@ -258,9 +256,9 @@ fn evaluate_batches<E: Evaluator>(evaluator: &E, networks: &[Network], seed: u64
     let helpers = threads.min(batches.ranges.len()).saturating_sub(1);
     rayon::scope(|scope| {
         for _ in 0..helpers {
-            scope.spawn(|_| batches.take_and_run(evaluator, seed, key));
+            scope.spawn(|_| batches.take_and_run(evaluator, streams));
         }
-        batches.take_and_run(evaluator, seed, key);
+        batches.take_and_run(evaluator, streams);
         while batches.done.load(Ordering::Acquire) < batches.ranges.len() {
             std::thread::yield_now();
         }
@@ -301,6 +299,7 @@ mod tests {
     use rand::Rng;
 
     use super::*;
+    use crate::rng::stream;
 
     /// A batched evaluator whose fitness is network `j`'s first gene plus
     /// the first draw of its stream; `fail_at` makes the network with that
@@ -403,7 +402,7 @@ mod tests {
             }
         }
         assert!(pool(2)
-            .install(|| evaluate_all(&CLEAN, &[], 5, &[]))
+            .install(|| evaluate_all(&CLEAN, &[] as &[Network], 5, &[]))
             .unwrap()
             .is_empty());
     }

@@ -1,14 +1,16 @@
 //! The PSA control problem as an [`Evaluator`] for the search algorithms.
 
+use std::ops::Range;
+
 use anyhow::Result;
 
 use crate::evolution::Evaluator;
-use crate::network::Network;
+use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
 use crate::psa::batch::LANES;
 use crate::psa::{BatchRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
-use crate::rng::Stream;
+use crate::rng::{Stream, StreamFamily};
 
 /// The environment variable that picks the `native` evaluation path:
 /// `scalar`, or a SIMD level (`portable`, `avx2`, `avx512`) for the batched
@@ -110,13 +112,20 @@ impl Evaluator for PsaEvaluator {
             1
         }
     }
-    fn evaluate_batch(&self, worker: &mut PsaWorker, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>> {
+    fn evaluate_batch<S: NetworkSet + ?Sized>(
+        &self,
+        worker: &mut PsaWorker,
+        networks: &S,
+        range: Range<usize>,
+        streams: &StreamFamily,
+    ) -> Result<Vec<f64>> {
         match &self.batch {
-            Some(batch) => Ok(batch.evaluate(networks, rngs)?),
-            None => networks
-                .iter()
-                .zip(rngs)
-                .map(|(network, rng)| self.evaluate(worker, network, rng))
+            Some(batch) => {
+                let mut rngs: Vec<Stream> = range.clone().map(|j| streams.stream(j)).collect();
+                Ok(batch.evaluate(networks, range, &mut rngs)?)
+            }
+            None => range
+                .map(|j| self.evaluate(worker, &networks.network(j), &mut streams.stream(j)))
                 .collect(),
         }
     }

@@ -11,9 +11,12 @@
 //! functions of [`crate::numeric`], [`PlanarBody::step`],
 //! [`SensorSettings::inputs_from`](super::SensorSettings::inputs_from) and
 //! [`FitnessSettings::points`](super::FitnessSettings::points), and the
-//! network's summation order (see [`Network::activate`]). So a network's
-//! fitness is bit-identical on both paths and on every [`SimdLevel`]; the
-//! tests hold the paths to that on thousands of random networks.
+//! network's summation order (see
+//! [`Network::activate`](crate::network::Network::activate)). So a
+//! network's fitness is bit-identical on both paths and on every
+//! [`SimdLevel`]; the tests hold the paths to that on thousands of random
+//! networks. The weights are read in place from any [`NetworkSet`], such
+//! as ESP's sub-populations.
 //!
 //! Random starts and the seeds of the noise sources are drawn lane by lane
 //! from each network's own stream, in the scalar path's order; the noise
@@ -27,7 +30,9 @@ use multiversion::multiversion;
 use super::fitness::StepError;
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
-use crate::network::Network;
+use std::ops::Range;
+
+use crate::network::NetworkSet;
 use crate::numeric::{clamp_unit, sigmoid, wrap_angle, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::Stream;
@@ -54,13 +59,14 @@ struct BlockWeights<const N: usize> {
 }
 
 impl<const N: usize> BlockWeights<N> {
-    fn new(networks: &[&Network]) -> BlockWeights<N> {
-        let hidden = networks.iter().map(|n| n.hidden()).max().unwrap_or(0);
+    /// The weights of networks `block` of `networks`, lane by lane.
+    fn new<S: NetworkSet + ?Sized>(networks: &S, block: Range<usize>) -> BlockWeights<N> {
+        let hidden = block.clone().map(|j| networks.hidden(j)).max().unwrap_or(0);
         let mut input = vec![Lanes::splat(0.0); hidden * INPUT_COUNT];
         let mut output = vec![Lanes::splat(0.0); hidden * THRUSTER_COUNT];
-        for (lane, network) in networks.iter().enumerate() {
-            for k in (0..network.hidden()).filter(|&k| !network.is_lesioned(k)) {
-                let (w_in, w_out) = network.neuron(k).split_at(INPUT_COUNT);
+        for (lane, j) in block.enumerate() {
+            for k in (0..networks.hidden(j)).filter(|&k| !networks.is_lesioned(j, k)) {
+                let (w_in, w_out) = networks.neuron(j, k).split_at(INPUT_COUNT);
                 for (i, &w) in w_in.iter().enumerate() {
                     input[k * INPUT_COUNT + i][lane] = w;
                 }
@@ -326,50 +332,60 @@ impl BatchRunner {
         self.level
     }
 
-    /// The fitness of every network, in % of the theoretical maximum, the
-    /// mean over `settings.trials` trials: exactly what
-    /// [`TrialRunner::evaluate`] gives network `i` with stream `rngs[i]`.
+    /// The fitness of networks `range` of `networks`, in % of the
+    /// theoretical maximum, the mean over `settings.trials` trials: exactly
+    /// what [`TrialRunner::evaluate`] gives network `range.start + i` with
+    /// stream `rngs[i]`.
     ///
     /// # Panics
-    /// If `networks` and `rngs` differ in length.
-    pub fn evaluate(&self, networks: &[&Network], rngs: &mut [Stream]) -> Result<Vec<f64>, PsaError> {
-        assert_eq!(networks.len(), rngs.len(), "one stream per network");
-        let mut fitness = Vec::with_capacity(networks.len());
+    /// If `range` and `rngs` differ in length, or `range` reaches past the
+    /// networks.
+    pub fn evaluate<S: NetworkSet + ?Sized>(
+        &self,
+        networks: &S,
+        range: Range<usize>,
+        rngs: &mut [Stream],
+    ) -> Result<Vec<f64>, PsaError> {
+        assert_eq!(range.len(), rngs.len(), "one stream per network");
+        let mut fitness = Vec::with_capacity(range.len());
         let noisy = self.settings.noise.is_active();
-        let mut start = 0;
-        while start < networks.len() {
-            let left = networks.len() - start;
+        let mut start = range.start;
+        while start < range.end {
+            let left = range.end - start;
             // Full wide blocks; a remainder that fits one goes in a narrow block.
             let width = if left > NARROW_LANES { LANES } else { NARROW_LANES };
-            let end = start + left.min(width);
-            let (block, streams) = (&networks[start..end], &mut rngs[start..end]);
+            let block = start..start + left.min(width);
+            let streams = &mut rngs[block.start - range.start..block.end - range.start];
             if width == LANES {
                 let fly = if noisy { wide_noisy::run } else { wide::run };
-                self.evaluate_block::<LANES>(fly, block, streams, &mut fitness)?;
+                self.evaluate_block::<LANES, S>(fly, networks, block.clone(), streams, &mut fitness)?;
             } else {
                 let fly = if noisy { narrow_noisy::run } else { narrow::run };
-                self.evaluate_block::<NARROW_LANES>(fly, block, streams, &mut fitness)?;
+                self.evaluate_block::<NARROW_LANES, S>(fly, networks, block.clone(), streams, &mut fitness)?;
             }
-            start = end;
+            start = block.end;
         }
         Ok(fitness)
     }
 
-    /// Evaluates up to N networks with the kernel `fly`, appending their fitness.
-    fn evaluate_block<const N: usize>(
+    /// Evaluates networks `block` (at most N) with the kernel `fly`,
+    /// appending their fitness.
+    fn evaluate_block<const N: usize, S: NetworkSet + ?Sized>(
         &self,
         fly: Kernel<N>,
-        networks: &[&Network],
+        networks: &S,
+        block: Range<usize>,
         rngs: &mut [Stream],
         fitness: &mut Vec<f64>,
     ) -> Result<(), PsaError> {
-        for network in networks {
-            TrialRunner::check_network(network)?;
+        for j in block.clone() {
+            let (inputs, outputs) = networks.shape(j);
+            TrialRunner::check_shape(inputs, outputs)?;
         }
         let s = &self.settings;
         // Where each stream stood, for a lane that must be re-run.
         let positions: Vec<u128> = rngs.iter().map(|r| r.get_word_pos()).collect();
-        let weights = BlockWeights::<N>::new(networks);
+        let weights = BlockWeights::<N>::new(networks, block.clone());
         let flight = Flight {
             settings: s,
             body: &self.body,
@@ -377,7 +393,7 @@ impl BatchRunner {
         };
         let maximum = s.fitness.maximum(s.steps);
         // trials[lane * s.trials + t]: lane's fitness in trial t.
-        let mut trials = vec![0.0; networks.len() * s.trials];
+        let mut trials = vec![0.0; block.len() * s.trials];
         let mut valid = Lanes::<N>::splat(0.0).le(Lanes::splat(0.0));
         for t in 0..s.trials {
             let mut starts = [PlanarState::from_body_state(&Default::default()); N];
@@ -390,7 +406,7 @@ impl BatchRunner {
                 targets[lane] = [target.x, target.y, target.heading];
                 seeds[lane] = s.noise.draw_seed(rng);
             }
-            for lane in networks.len()..N {
+            for lane in block.len()..N {
                 (starts[lane], targets[lane]) = (starts[0], targets[0]);
             }
             let mut noise = NoiseSource::from_seeds(&seeds);
@@ -404,7 +420,7 @@ impl BatchRunner {
             let target = [0, 1, 2].map(|i| lanes(&|l| targets[l][i]));
             let (points, ok) = fly(self.level, &flight, &mut state, &target, &mut noise);
             valid = valid & ok;
-            for lane in 0..networks.len() {
+            for lane in 0..block.len() {
                 trials[lane * s.trials + t] = 100.0 * points[lane] / maximum;
             }
         }
@@ -414,7 +430,8 @@ impl BatchRunner {
             } else {
                 // The scalar path, from the lane's original stream, names the problem.
                 rngs[lane].set_word_pos(positions[lane]);
-                fitness.push(TrialRunner::new(s, self.task)?.evaluate(networks[lane], &mut rngs[lane])?);
+                let network = networks.network(block.start + lane);
+                fitness.push(TrialRunner::new(s, self.task)?.evaluate(&network, &mut rngs[lane])?);
             }
         }
         Ok(())

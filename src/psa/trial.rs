@@ -156,11 +156,14 @@ impl TrialRunner {
     }
 
     pub(crate) fn check_network(network: &Network) -> Result<(), PsaError> {
-        if network.inputs() != INPUT_COUNT || network.outputs() != THRUSTER_COUNT {
+        Self::check_shape(network.inputs(), network.outputs())
+    }
+
+    /// Refuses a network shape other than the PSA's.
+    pub(crate) fn check_shape(inputs: usize, outputs: usize) -> Result<(), PsaError> {
+        if inputs != INPUT_COUNT || outputs != THRUSTER_COUNT {
             return Err(PsaError::Network(format!(
-                "it has {} inputs and {} outputs, the PSA needs {INPUT_COUNT} and {THRUSTER_COUNT}",
-                network.inputs(),
-                network.outputs()
+                "it has {inputs} inputs and {outputs} outputs, the PSA needs {INPUT_COUNT} and {THRUSTER_COUNT}"
             )));
         }
         Ok(())
