@@ -6,7 +6,7 @@
 use psa_esp::network::Network;
 use psa_esp::numeric::SimdLevel;
 use psa_esp::physics::BackendKind;
-use psa_esp::psa::batch::{LANES, NARROW_LANES};
+use psa_esp::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
 use psa_esp::psa::{BatchRunner, FitnessKind, NoiseSettings, PsaSettings, Task, TrialRunner};
 use psa_esp::rng::{stream, Stream};
 use rand::RngExt;
@@ -130,37 +130,42 @@ fn every_simd_level_computes_the_same_bits_the_portable_fallback_included() {
 }
 
 #[test]
-fn a_partial_block_a_range_and_a_single_network_give_the_same_fitness_as_a_full_block() {
+fn blocks_of_every_width_and_ranges_of_a_set_give_the_same_fitness_as_a_full_block() {
     let settings = native(PsaSettings::default());
     let runner = BatchRunner::new(&settings, Task::StopRotation).unwrap();
-    // A full wide block, then a padded wide one (more than NARROW_LANES
-    // left); alone, each network flies in a padded narrow block.
+    // A full wide block, then a padded wide one (more than NARROW_LANES left).
     let count = (LANES + NARROW_LANES + 5) as u64;
     let networks: Vec<Network> = (0..count).map(random_network).collect();
     let refs: Vec<&Network> = networks.iter().collect();
     let all = runner.evaluate(&refs, 0..refs.len(), &mut streams(0..count)).unwrap();
-    for (i, network) in networks.iter().enumerate() {
-        let alone = runner
-            .evaluate(&[network][..], 0..1, &mut [stream(i as u64, &[2])])
-            .unwrap();
-        assert_eq!(alone[0].to_bits(), all[i].to_bits(), "network {i}");
-        // The same network as a one-network range of the whole set.
-        let in_place = runner
-            .evaluate(&networks, i..i + 1, &mut [stream(i as u64, &[2])])
-            .unwrap();
-        assert_eq!(in_place[0].to_bits(), all[i].to_bits(), "network {i} in place");
-    }
-    // A range that starts mid-set and spans a wide and a narrow block.
-    let range = 3..LANES + 9;
-    let part = runner
-        .evaluate(
-            &networks,
-            range.clone(),
-            &mut streams(range.start as u64..range.end as u64),
-        )
-        .unwrap();
     let bits = |f: &[f64]| f.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-    assert_eq!(bits(&part), bits(&all[range]));
+    for level in SimdLevel::ALL {
+        let runner = runner.clone().with_level(level);
+        for (i, network) in networks.iter().enumerate() {
+            // Alone, a network flies in a padded small block.
+            let alone = runner
+                .evaluate(&[network][..], 0..1, &mut [stream(i as u64, &[2])])
+                .unwrap();
+            assert_eq!(alone[0].to_bits(), all[i].to_bits(), "network {i}, {level}");
+            // The same network as a one-network range of the whole set.
+            let in_place = runner
+                .evaluate(&networks, i..i + 1, &mut [stream(i as u64, &[2])])
+                .unwrap();
+            assert_eq!(in_place[0].to_bits(), all[i].to_bits(), "network {i} in place, {level}");
+        }
+        // Ranges from mid-set: a wide and a padded small block, a padded
+        // narrow block, a wide and a full small block.
+        for range in [3..LANES + 9, 5..5 + SMALL_LANES + 4, 10..10 + LANES + SMALL_LANES] {
+            let part = runner
+                .evaluate(
+                    &networks,
+                    range.clone(),
+                    &mut streams(range.start as u64..range.end as u64),
+                )
+                .unwrap();
+            assert_eq!(bits(&part), bits(&all[range.clone()]), "{range:?}, {level}");
+        }
+    }
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! The batched evaluation path: blocks of [`LANES`] networks (and of
-//! [`NARROW_LANES`] for what is left over) fly the PSA in lockstep, one per
-//! SIMD lane, on the `native` backend's physics.
+//! [`NARROW_LANES`] or [`SMALL_LANES`] for what is left over) fly the PSA in
+//! lockstep, one per SIMD lane, on the `native` backend's physics.
 //!
 //! Weights and states are kept as structures of arrays ([`Lanes`]), and every
 //! step runs the arithmetic the scalar path ([`TrialRunner`] with the
@@ -46,6 +46,11 @@ pub const LANES: usize = 32;
 /// networks a generation (12 wide blocks and 16 left), measured 6 % faster
 /// overall than 8 lanes.
 pub const NARROW_LANES: usize = 16;
+/// The kernel's width for a remainder of at most this many networks: one
+/// AVX-512 register per value. On two threads, the 16 networks left of the
+/// baseline ESP's 400 go one piece of 8 to each thread; in a narrow block,
+/// half of its lanes would fly for nothing.
+pub const SMALL_LANES: usize = 8;
 
 /// The weights of a block of networks, lane by lane. Lesioned hidden
 /// neurons, and the missing neurons of networks smaller than the block's
@@ -89,10 +94,15 @@ struct Flight<'a, const N: usize> {
 /// One trial of every lane from `state` towards `target` (x, y, heading),
 /// with lane l's noise from lane l of `noise` if `NOISY` (compiled apart, so
 /// that the noise code costs noiseless flights nothing). Returns the points
-/// and which lanes ended with a finite velocity and spin. `N2` is `2 N` to
-/// evaluate the neurons two at a time with [`sigmoid_pair`], `N` to evaluate
-/// them one by one (measured on Zen 5: pairs are faster on AVX-512 and
-/// slower on AVX2, which has half as many registers).
+/// and which lanes ended with a finite velocity and spin. The logistic
+/// functions run `G` neurons at a time, as one block of `NG = G N` lanes:
+/// `G = 2` in pairs ([`sigmoid_pair`]), `G >= 4` the hidden neurons in groups
+/// of `G` and the four outputs in one group ([`sigmoid_group`]), `G = 1`
+/// one by one. Measured on Zen 5: pairs are faster in the wide AVX-512
+/// kernel and slower on AVX2, which has half as many registers; groups of
+/// five make the narrow AVX-512 kernel 16-20 % faster and the small one
+/// 25-35 % (one AVX-512 register per value leaves a single neuron's
+/// logistic function waiting on its own dependency chain).
 ///
 /// A lane whose thrust turned NaN is always among those that did not: a NaN
 /// command makes its thruster's world-frame force NaN (`PlanarBody` keeps
@@ -101,14 +111,19 @@ struct Flight<'a, const N: usize> {
 /// checking them once, after the flight, finds every such lane (and,
 /// conservatively, any lane whose state overflowed), without a check per
 /// step.
+// Plain index loops over constant ranges in the kernel: a scratch build
+// that built these arrays with closures and iterator adaptors ran several
+// times slower.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
-fn fly<const N: usize, const N2: usize, const NOISY: bool>(
+fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     flight: &Flight<N>,
     state: &mut PlanarState<Lanes<N>>,
     target: &[Lanes<N>; 3],
     noise: &mut NoiseSource<Words<N>>,
 ) -> (Lanes<N>, LaneMask<N>) {
     type V<const N: usize> = Lanes<N>;
+    assert!(G <= 2 || G >= THRUSTER_COUNT, "groups hold all four outputs");
     let s = flight.settings;
     let weights = flight.weights;
     let zero = V::<N>::splat(0.0);
@@ -123,22 +138,39 @@ fn fly<const N: usize, const N2: usize, const NOISY: bool>(
             s.noise.perturb_inputs(&mut inputs, noise);
         }
         let mut outputs = [zero; THRUSTER_COUNT];
-        let paired = N2 == 2 * N;
+        let (paired, grouped) = (G == 2, G >= THRUSTER_COUNT);
         let mut k = 0;
         while paired && k + 2 <= weights.hidden {
-            let [h0, h1] = sigmoid_pair::<N, N2>(dot(weights, &inputs, k), dot(weights, &inputs, k + 1));
+            let [h0, h1] = sigmoid_pair::<N, NG>(dot(weights, &inputs, k), dot(weights, &inputs, k + 1));
             accumulate(weights, &mut outputs, h0, k);
             accumulate(weights, &mut outputs, h1, k + 1);
             k += 2;
+        }
+        while grouped && k + G <= weights.hidden {
+            let mut net = [zero; G];
+            for i in 0..G {
+                net[i] = dot(weights, &inputs, k + i);
+            }
+            let h = sigmoid_group::<N, NG, G>(&net);
+            for i in 0..G {
+                accumulate(weights, &mut outputs, h[i], k + i);
+            }
+            k += G;
         }
         for k in k..weights.hidden {
             let h = sigmoid(dot(weights, &inputs, k));
             accumulate(weights, &mut outputs, h, k);
         }
         if paired {
-            let [o0, o1] = sigmoid_pair::<N, N2>(outputs[0], outputs[1]);
-            let [o2, o3] = sigmoid_pair::<N, N2>(outputs[2], outputs[3]);
+            let [o0, o1] = sigmoid_pair::<N, NG>(outputs[0], outputs[1]);
+            let [o2, o3] = sigmoid_pair::<N, NG>(outputs[2], outputs[3]);
             outputs = [o0, o1, o2, o3];
+        } else if grouped {
+            // All four outputs in one group, padded with zeros.
+            let mut net = [zero; G];
+            net[..THRUSTER_COUNT].copy_from_slice(&outputs);
+            let o = sigmoid_group::<N, NG, G>(&net);
+            outputs.copy_from_slice(&o[..THRUSTER_COUNT]);
         } else {
             for o in &mut outputs {
                 *o = sigmoid(*o);
@@ -191,6 +223,23 @@ fn sigmoid_pair<const N: usize, const N2: usize>(a: Lanes<N>, b: Lanes<N>) -> [L
     [first, second]
 }
 
+/// [`sigmoid_pair`] for `G` blocks, as one block of `NG = G N` lanes.
+#[allow(clippy::needless_range_loop)] // as in `fly`
+#[inline(always)]
+fn sigmoid_group<const N: usize, const NG: usize, const G: usize>(blocks: &[Lanes<N>; G]) -> [Lanes<N>; G] {
+    assert_eq!(NG, G * N, "a group is G blocks wide");
+    let mut all = Lanes::<NG>::splat(0.0);
+    for i in 0..G {
+        all.0[i * N..(i + 1) * N].copy_from_slice(&blocks[i].0);
+    }
+    let all = sigmoid(all);
+    let mut out = *blocks;
+    for i in 0..G {
+        out[i].0.copy_from_slice(&all.0[i * N..(i + 1) * N]);
+    }
+    out
+}
+
 /// Hidden neuron `k`'s net input: its weighted sum of the inputs, multiplied
 /// and added in input order (the scalar network's order).
 #[inline(always)]
@@ -221,8 +270,8 @@ fn accumulate<const N: usize>(
 
 /// The kernel of width `$n`, with or without noise, as a function with the
 /// attributes given (a `multiversion` target list, or none for the portable
-/// build), evaluating the neurons' logistic functions `$group` lanes at a time
-/// (`$n` or `2 * $n`, see [`fly`]).
+/// build), evaluating the neurons' logistic functions `$group` neurons at a
+/// time (see [`fly`]).
 macro_rules! kernel {
     ($(#[$attr:meta])* $name:ident, $n:expr, $group:expr, $noisy:expr) => {
         $(#[$attr])*
@@ -232,15 +281,17 @@ macro_rules! kernel {
             target: &[Lanes<$n>; 3],
             noise: &mut NoiseSource<Words<$n>>,
         ) -> (Lanes<$n>, LaneMask<$n>) {
-            fly::<$n, { $group }, $noisy>(flight, state, target, noise)
+            fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise)
         }
     };
 }
 
 /// A module `$module` holding the kernel of width `$n` (noisy or not)
-/// compiled for each [`SimdLevel`], and `run`, which runs the one asked for.
+/// compiled for each [`SimdLevel`], with the logistic functions `$g512`
+/// neurons at a time on AVX-512 and `$g256` on AVX2 (one at a time on the
+/// portable build), and `run`, which runs the one asked for.
 macro_rules! kernels {
-    ($module:ident, $n:expr, $noisy:expr) => {
+    ($module:ident, $n:expr, $noisy:expr, $g512:expr, $g256:expr) => {
         mod $module {
             use super::*;
 
@@ -248,17 +299,17 @@ macro_rules! kernels {
                 #[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))]
                 avx512,
                 $n,
-                2 * $n,
+                $g512,
                 $noisy
             );
             kernel!(
                 #[multiversion(targets("x86_64+avx2+fma"))]
                 avx2,
                 $n,
-                $n,
+                $g256,
                 $noisy
             );
-            kernel!(portable, $n, $n, $noisy);
+            kernel!(portable, $n, 1, $noisy);
 
             pub(super) fn run(
                 level: SimdLevel,
@@ -277,10 +328,12 @@ macro_rules! kernels {
     };
 }
 
-kernels!(wide, LANES, false);
-kernels!(wide_noisy, LANES, true);
-kernels!(narrow, NARROW_LANES, false);
-kernels!(narrow_noisy, NARROW_LANES, true);
+kernels!(wide, LANES, false, 2, 1);
+kernels!(wide_noisy, LANES, true, 2, 1);
+kernels!(narrow, NARROW_LANES, false, 5, 1);
+kernels!(narrow_noisy, NARROW_LANES, true, 5, 1);
+kernels!(small, SMALL_LANES, false, 5, 1);
+kernels!(small_noisy, SMALL_LANES, true, 5, 1);
 
 /// A kernel of width N run on a [`SimdLevel`].
 type Kernel<const N: usize> = fn(
@@ -352,16 +405,30 @@ impl BatchRunner {
         let mut start = range.start;
         while start < range.end {
             let left = range.end - start;
-            // Full wide blocks; a remainder that fits one goes in a narrow block.
-            let width = if left > NARROW_LANES { LANES } else { NARROW_LANES };
+            // Full wide blocks; a remainder goes in the narrowest block it fits.
+            let width = if left > NARROW_LANES {
+                LANES
+            } else if left > SMALL_LANES {
+                NARROW_LANES
+            } else {
+                SMALL_LANES
+            };
             let block = start..start + left.min(width);
             let streams = &mut rngs[block.start - range.start..block.end - range.start];
-            if width == LANES {
-                let fly = if noisy { wide_noisy::run } else { wide::run };
-                self.evaluate_block::<LANES, S>(fly, networks, block.clone(), streams, &mut fitness)?;
-            } else {
-                let fly = if noisy { narrow_noisy::run } else { narrow::run };
-                self.evaluate_block::<NARROW_LANES, S>(fly, networks, block.clone(), streams, &mut fitness)?;
+            let out = &mut fitness;
+            match width {
+                LANES => {
+                    let fly = if noisy { wide_noisy::run } else { wide::run };
+                    self.evaluate_block::<LANES, S>(fly, networks, block.clone(), streams, out)?;
+                }
+                NARROW_LANES => {
+                    let fly = if noisy { narrow_noisy::run } else { narrow::run };
+                    self.evaluate_block::<NARROW_LANES, S>(fly, networks, block.clone(), streams, out)?;
+                }
+                _ => {
+                    let fly = if noisy { small_noisy::run } else { small::run };
+                    self.evaluate_block::<SMALL_LANES, S>(fly, networks, block.clone(), streams, out)?;
+                }
             }
             start = block.end;
         }
