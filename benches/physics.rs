@@ -106,7 +106,7 @@ fn psa_evaluation(c: &mut Criterion) {
             b.iter(|| {
                 let mut rngs: Vec<_> = (0..networks.len()).map(|_| psa_esp::rng::stream(0, &[])).collect();
                 runner
-                    .evaluate(&networks, 0..networks.len(), &mut rngs)
+                    .evaluate(&networks[..], 0..networks.len(), &mut rngs)
                     .expect("evaluate")
             })
         });

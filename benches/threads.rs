@@ -34,7 +34,7 @@ fn evaluations(c: &mut Criterion) {
             let pool = thread_pool(threads).expect("thread pool");
             group.bench_function(on_threads(&path.label(), threads), |b| {
                 b.iter(|| {
-                    pool.install(|| evaluate_all(&evaluator, &networks, 0, &[]))
+                    pool.install(|| evaluate_all(&evaluator, &networks[..], 0, &[]))
                         .expect("evaluate")
                 })
             });

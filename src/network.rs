@@ -106,27 +106,6 @@ impl<N: Borrow<Network> + Sync> NetworkSet for [N] {
     }
 }
 
-impl<N: Borrow<Network> + Sync> NetworkSet for Vec<N> {
-    fn len(&self) -> usize {
-        self.as_slice().len()
-    }
-    fn shape(&self, j: usize) -> (usize, usize) {
-        self.as_slice().shape(j)
-    }
-    fn hidden(&self, j: usize) -> usize {
-        self.as_slice().hidden(j)
-    }
-    fn neuron(&self, j: usize, k: usize) -> &[f64] {
-        self.as_slice().neuron(j, k)
-    }
-    fn is_lesioned(&self, j: usize, k: usize) -> bool {
-        self.as_slice().is_lesioned(j, k)
-    }
-    fn network(&self, j: usize) -> Cow<'_, Network> {
-        self.as_slice().network(j)
-    }
-}
-
 /// A 1-hidden-layer network; see the module docs for the gene layout.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Network {

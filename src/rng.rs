@@ -23,7 +23,12 @@ fn mix(mut z: u64) -> u64 {
 /// The stream for `seed` and the key path `key` (e.g. `[PURPOSE, generation,
 /// network, trial]`). Different keys give independent streams.
 pub fn stream(seed: u64, key: &[u64]) -> Stream {
-    from_state(key.iter().fold(mix(seed), |state, &k| step(state, k)))
+    from_state(key_state(seed, key))
+}
+
+/// The state that `seed` and the key path `key` hash to.
+fn key_state(seed: u64, key: &[u64]) -> u64 {
+    key.iter().fold(mix(seed), |state, &k| step(state, k))
 }
 
 /// The key state after one more key element.
@@ -53,7 +58,7 @@ impl StreamFamily {
     /// The family of `seed` and the key prefix `key`.
     pub fn new(seed: u64, key: &[u64]) -> StreamFamily {
         StreamFamily {
-            state: key.iter().fold(mix(seed), |state, &k| step(state, k)),
+            state: key_state(seed, key),
         }
     }
 

@@ -55,7 +55,7 @@ fn both_paths(
     let batched = BatchRunner::new(settings, task)
         .unwrap()
         .with_level(level)
-        .evaluate(&refs, 0..refs.len(), &mut streams(seeds))
+        .evaluate(&refs[..], 0..refs.len(), &mut streams(seeds))
         .unwrap();
     (scalar, batched)
 }
@@ -137,7 +137,9 @@ fn blocks_of_every_width_and_ranges_of_a_set_give_the_same_fitness_as_a_full_blo
     let count = (LANES + NARROW_LANES + 5) as u64;
     let networks: Vec<Network> = (0..count).map(random_network).collect();
     let refs: Vec<&Network> = networks.iter().collect();
-    let all = runner.evaluate(&refs, 0..refs.len(), &mut streams(0..count)).unwrap();
+    let all = runner
+        .evaluate(&refs[..], 0..refs.len(), &mut streams(0..count))
+        .unwrap();
     let bits = |f: &[f64]| f.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
     for level in SimdLevel::ALL {
         let runner = runner.clone().with_level(level);
@@ -149,7 +151,7 @@ fn blocks_of_every_width_and_ranges_of_a_set_give_the_same_fitness_as_a_full_blo
             assert_eq!(alone[0].to_bits(), all[i].to_bits(), "network {i}, {level}");
             // The same network as a one-network range of the whole set.
             let in_place = runner
-                .evaluate(&networks, i..i + 1, &mut [stream(i as u64, &[2])])
+                .evaluate(&networks[..], i..i + 1, &mut [stream(i as u64, &[2])])
                 .unwrap();
             assert_eq!(in_place[0].to_bits(), all[i].to_bits(), "network {i} in place, {level}");
         }
@@ -158,7 +160,7 @@ fn blocks_of_every_width_and_ranges_of_a_set_give_the_same_fitness_as_a_full_blo
         for range in [3..LANES + 9, 5..5 + SMALL_LANES + 4, 10..10 + LANES + SMALL_LANES] {
             let part = runner
                 .evaluate(
-                    &networks,
+                    &networks[..],
                     range.clone(),
                     &mut streams(range.start as u64..range.end as u64),
                 )

@@ -551,7 +551,12 @@ impl Esp {
             lesioned.set_lesioned(k, true);
             variants.push(lesioned);
         }
-        let fitness = evaluate_all(evaluator, &variants, self.seed, &[purpose::LESION, generation as u64])?;
+        let fitness = evaluate_all(
+            evaluator,
+            &variants[..],
+            self.seed,
+            &[purpose::LESION, generation as u64],
+        )?;
         state.evaluations += variants.len() as u64;
         let whole = fitness[0];
         let (neuron, kept) = best_of(&fitness[1..]);

@@ -46,10 +46,23 @@ pub trait Evaluator: Sync {
         range: Range<usize>,
         streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
-        range
-            .map(|j| self.evaluate(worker, &networks.network(j), &mut streams.stream(j)))
-            .collect()
+        evaluate_each(self, worker, networks, range, streams)
     }
+}
+
+/// [`Evaluator::evaluate_batch`] network by network, through
+/// [`Evaluator::evaluate`]: the default, and what a batched evaluator falls
+/// back on.
+pub fn evaluate_each<E: Evaluator + ?Sized, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    worker: &mut E::Worker,
+    networks: &S,
+    range: Range<usize>,
+    streams: &StreamFamily,
+) -> Result<Vec<f64>> {
+    range
+        .map(|j| evaluator.evaluate(worker, &networks.network(j), &mut streams.stream(j)))
+        .collect()
 }
 
 /// An [`Evaluator`] from a plain function.
@@ -396,7 +409,7 @@ mod tests {
         for threads in [1, 2, 3, 5] {
             for _ in 0..20 {
                 let got = pool(threads)
-                    .install(|| evaluate_all(&CLEAN, &nets, 5, &[3, 9]))
+                    .install(|| evaluate_all(&CLEAN, &nets[..], 5, &[3, 9]))
                     .unwrap();
                 assert_eq!(got, expected, "{threads} threads");
             }
@@ -416,14 +429,16 @@ mod tests {
                 ..CLEAN
             };
             let error = pool(threads)
-                .install(|| evaluate_all(&failing, &nets, 1, &[]))
+                .install(|| evaluate_all(&failing, &nets[..], 1, &[]))
                 .unwrap_err();
             assert!(format!("{error:#}").contains("gene 33 failed"), "{error:#}");
             let nan = Batched {
                 nan_at: Some(21.0),
                 ..CLEAN
             };
-            let error = pool(threads).install(|| evaluate_all(&nan, &nets, 1, &[])).unwrap_err();
+            let error = pool(threads)
+                .install(|| evaluate_all(&nan, &nets[..], 1, &[]))
+                .unwrap_err();
             assert!(error.to_string().contains("NaN for network 21"), "{error}");
         }
     }
@@ -434,14 +449,14 @@ mod tests {
         // evaluate_all again and again, so no thread is free to take
         // another's batches; each must evaluate its own.
         let nets = networks(50);
-        let expected = pool(1).install(|| evaluate_all(&CLEAN, &nets, 2, &[7])).unwrap();
+        let expected = pool(1).install(|| evaluate_all(&CLEAN, &nets[..], 2, &[7])).unwrap();
         let runs: Vec<Vec<f64>> = pool(2).install(|| {
             (0..6)
                 .into_par_iter()
                 .map(|_| {
                     let mut last = Vec::new();
                     for _ in 0..200 {
-                        last = evaluate_all(&CLEAN, &nets, 2, &[7]).unwrap();
+                        last = evaluate_all(&CLEAN, &nets[..], 2, &[7]).unwrap();
                     }
                     last
                 })
@@ -457,6 +472,6 @@ mod tests {
             panic_from: Some(30.0),
             ..CLEAN
         };
-        let _ = pool(2).install(|| evaluate_all(&panicking, &networks(40), 1, &[]));
+        let _ = pool(2).install(|| evaluate_all(&panicking, &networks(40)[..], 1, &[]));
     }
 }

@@ -171,7 +171,12 @@ impl HillClimb {
                     Network::from_genes(inputs, outputs, genes)
                 })
                 .collect::<Result<Vec<_>, _>>()?;
-            let fitness = evaluate_all(evaluator, &candidates, self.seed, &[purpose::EVALUATE, cycle as u64])?;
+            let fitness = evaluate_all(
+                evaluator,
+                &candidates[..],
+                self.seed,
+                &[purpose::EVALUATE, cycle as u64],
+            )?;
             evaluations += candidates.len() as u64;
             let (top, top_fitness) = best_of(&fitness);
             if champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {

@@ -4,7 +4,7 @@ use std::ops::Range;
 
 use anyhow::Result;
 
-use crate::evolution::Evaluator;
+use crate::evolution::{evaluate_each, Evaluator};
 use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
@@ -124,9 +124,7 @@ impl Evaluator for PsaEvaluator {
                 let mut rngs: Vec<Stream> = range.clone().map(|j| streams.stream(j)).collect();
                 Ok(batch.evaluate(networks, range, &mut rngs)?)
             }
-            None => range
-                .map(|j| self.evaluate(worker, &networks.network(j), &mut streams.stream(j)))
-                .collect(),
+            None => evaluate_each(self, worker, networks, range, streams),
         }
     }
 }
