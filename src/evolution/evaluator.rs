@@ -2,7 +2,7 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
@@ -156,42 +156,96 @@ static BATCH_CALLS: AtomicU64 = AtomicU64::new(0);
 /// sleep. ESP's own work between two evaluations takes well under this.
 const KEEP_WARM: Duration = Duration::from_millis(2);
 
-/// The batches `networks` networks are evaluated in: as many full batches
-/// of `size` as fit, then what is left in one piece per thread, so that
-/// the threads finish together.
-fn batch_ranges(networks: usize, size: usize, threads: usize) -> Vec<Range<usize>> {
-    let full = networks / size * size;
-    let mut ranges: Vec<Range<usize>> = (0..full).step_by(size).map(|start| start..start + size).collect();
-    let left = networks - full;
-    let pieces = threads.clamp(1, left.max(1));
-    ranges.extend(
-        (0..pieces)
-            .map(|p| full + left * p / pieces..full + left * (p + 1) / pieces)
-            .filter(|range| !range.is_empty()),
-    );
-    ranges
+/// Which networks each thread evaluates next: first the full batches of
+/// `size`, one at a time, then the tail, the fewer than `size` networks
+/// left, shared out among the threads still to reach it.
+///
+/// The tail is cut when a thread reaches it, not beforehand: a thread takes
+/// its share of what is left, counting itself and every thread that is
+/// still taking batches and has not yet had a piece of the tail, so that
+/// the threads finish together when they all take part; a thread alone
+/// (in `replicate`, where every thread runs a run of its own, the helpers
+/// rarely come) takes all of it in one batch instead of several smaller
+/// ones, each about as slow as the whole when the batch is too narrow to
+/// fill the SIMD units. A thread that comes back for more takes its share
+/// again, at least one network, so the tail is always taken whole.
+#[derive(Debug)]
+struct Schedule {
+    size: usize,
+    networks: usize,
+    /// The next full batch to take.
+    next_batch: AtomicUsize,
+    /// The first network of the tail not yet taken.
+    next_in_tail: AtomicUsize,
+    /// Threads taking batches that have not yet had a piece of the tail.
+    still_to_share: AtomicUsize,
+}
+
+impl Schedule {
+    fn new(networks: usize, size: usize) -> Schedule {
+        let size = size.max(1);
+        Schedule {
+            size,
+            networks,
+            next_batch: AtomicUsize::new(0),
+            next_in_tail: AtomicUsize::new(networks / size * size),
+            still_to_share: AtomicUsize::new(0),
+        }
+    }
+
+    /// Counts a thread in among those that will take batches.
+    fn join(&self) {
+        self.still_to_share.fetch_add(1, Ordering::AcqRel);
+    }
+
+    /// The next batch for a thread that has [joined](Schedule::join);
+    /// `shared` says whether it has had a piece of the tail yet. `None`
+    /// when every network is taken.
+    fn take(&self, shared: &mut bool) -> Option<Range<usize>> {
+        let batch = self.next_batch.fetch_add(1, Ordering::AcqRel);
+        if batch < self.networks / self.size {
+            return Some(batch * self.size..(batch + 1) * self.size);
+        }
+        // This thread, and the others still to share.
+        let takers = if *shared {
+            self.still_to_share.load(Ordering::Acquire) + 1
+        } else {
+            *shared = true;
+            self.still_to_share.fetch_sub(1, Ordering::AcqRel)
+        };
+        let mut start = self.next_in_tail.load(Ordering::Acquire);
+        loop {
+            let left = self.networks.checked_sub(start).filter(|&left| left > 0)?;
+            let end = start + left.div_ceil(takers.max(1));
+            match self
+                .next_in_tail
+                .compare_exchange(start, end, Ordering::AcqRel, Ordering::Acquire)
+            {
+                Ok(_) => return Some(start..end),
+                Err(now) => start = now,
+            }
+        }
+    }
 }
 
 /// The batches of one [`evaluate_batches`] call, taken one at a time by
 /// whichever thread is free.
 struct Batches<'a, S: ?Sized> {
     networks: &'a S,
-    ranges: Vec<Range<usize>>,
-    /// The next batch to take.
-    next: AtomicUsize,
-    /// Batches finished (or abandoned by a panic).
+    schedule: Schedule,
+    /// Networks evaluated (or abandoned by a panic).
     done: AtomicUsize,
-    /// Each batch's result, set once by the thread that took it.
-    results: Vec<OnceLock<Result<Vec<f64>>>>,
+    /// Each batch's first network and result.
+    results: Mutex<Vec<(usize, Result<Vec<f64>>)>>,
 }
 
-/// Counts a batch as done when dropped, so that a panicking evaluation
-/// never leaves the calling thread waiting for it.
-struct CountDone<'a>(&'a AtomicUsize);
+/// Counts a batch's networks as done when dropped, so that a panicking
+/// evaluation never leaves the calling thread waiting for it.
+struct CountDone<'a>(&'a AtomicUsize, usize);
 
 impl Drop for CountDone<'_> {
     fn drop(&mut self) {
-        self.0.fetch_add(1, Ordering::Release);
+        self.0.fetch_add(self.1, Ordering::Release);
     }
 }
 
@@ -199,14 +253,15 @@ impl<S: NetworkSet + ?Sized> Batches<'_, S> {
     /// Takes and evaluates batches until none is left.
     fn take_and_run<E: Evaluator>(&self, evaluator: &E, streams: &StreamFamily) {
         let mut worker = None;
-        loop {
-            let b = self.next.fetch_add(1, Ordering::AcqRel);
-            let Some(range) = self.ranges.get(b) else {
-                return;
-            };
-            let _done = CountDone(&self.done);
+        let mut shared = false;
+        self.schedule.join();
+        while let Some(range) = self.schedule.take(&mut shared) {
+            let _done = CountDone(&self.done, range.len());
             let result = self.evaluate(evaluator, &mut worker, range.clone(), streams);
-            assert!(self.results[b].set(result).is_ok(), "each batch is taken once");
+            self.results
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .push((range.start, result));
         }
     }
 
@@ -233,9 +288,10 @@ impl<S: NetworkSet + ?Sized> Batches<'_, S> {
 }
 
 /// [`evaluate_all`] for a batched evaluator: batches of
-/// [`Evaluator::batch_size`] networks (see [`batch_ranges`]), which the
-/// threads take one at a time as they come free, so that a thread slowed
-/// down (on a shared host, say) does less of the work.
+/// [`Evaluator::batch_size`] networks and a tail shared out among the
+/// threads that reach it (see [`Schedule`]), which the threads take one at
+/// a time as they come free, so that a thread slowed down (on a shared
+/// host, say) does less of the work.
 ///
 /// The calling thread offers the pool one helper job per other thread,
 /// takes batches until none is left, and then waits for the batches the
@@ -258,30 +314,33 @@ fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
 ) -> Result<Vec<f64>> {
     BATCH_CALLS.fetch_add(1, Ordering::AcqRel);
     let threads = rayon::current_num_threads();
-    let ranges = batch_ranges(networks.len(), evaluator.batch_size(), threads);
+    let size = evaluator.batch_size();
     let batches = Batches {
         networks,
-        results: ranges.iter().map(|_| OnceLock::new()).collect(),
-        ranges,
-        next: AtomicUsize::new(0),
+        schedule: Schedule::new(networks.len(), size),
         done: AtomicUsize::new(0),
+        results: Mutex::new(Vec::new()),
     };
-    let helpers = threads.min(batches.ranges.len()).saturating_sub(1);
+    // No more helpers than batches could keep busy.
+    let (full, tail) = (networks.len() / size, networks.len() % size);
+    let helpers = threads.min(full + tail.min(threads)).saturating_sub(1);
     rayon::scope(|scope| {
         for _ in 0..helpers {
             scope.spawn(|_| batches.take_and_run(evaluator, streams));
         }
         batches.take_and_run(evaluator, streams);
-        while batches.done.load(Ordering::Acquire) < batches.ranges.len() {
+        while batches.done.load(Ordering::Acquire) < networks.len() {
             std::thread::yield_now();
         }
     });
     for _ in 0..helpers {
         keep_warm();
     }
+    let mut results = batches.results.into_inner().unwrap_or_else(PoisonError::into_inner);
+    results.sort_unstable_by_key(|&(start, _)| start);
     let mut fitness = Vec::with_capacity(networks.len());
-    for result in batches.results {
-        fitness.extend(result.into_inner().expect("every batch was evaluated")?);
+    for (_, result) in results {
+        fitness.extend(result?);
     }
     Ok(fitness)
 }
@@ -370,32 +429,94 @@ mod tests {
         panic_from: None,
     };
 
+    /// Every batch `schedule` gives the threads, which all join first,
+    /// `order` naming which thread takes next, until every thread has found
+    /// nothing left.
+    fn takes(schedule: &Schedule, order: &[usize]) -> Vec<(usize, Range<usize>)> {
+        let threads = order.iter().max().map_or(0, |&t| t + 1);
+        (0..threads).for_each(|_| schedule.join());
+        let (mut shared, mut finished) = (vec![false; threads], vec![false; threads]);
+        let mut taken = Vec::new();
+        for &t in order.iter().cycle() {
+            if finished.iter().all(|&f| f) {
+                break;
+            }
+            if finished[t] {
+                continue;
+            }
+            match schedule.take(&mut shared[t]) {
+                Some(range) => taken.push((t, range)),
+                None => finished[t] = true,
+            }
+        }
+        taken
+    }
+
     #[test]
-    fn full_batches_come_first_and_the_rest_is_split_over_the_threads() {
-        let ranges = |n, threads| batch_ranges(n, 32, threads);
-        assert_eq!(
-            ranges(400, 1),
-            [
-                0..32,
-                32..64,
-                64..96,
-                96..128,
-                128..160,
-                160..192,
-                192..224,
-                224..256,
-                256..288,
-                288..320,
-                320..352,
-                352..384,
-                384..400
-            ]
-        );
-        assert_eq!(ranges(400, 2)[11..], [352..384, 384..392, 392..400]);
-        assert_eq!(ranges(64, 2), [0..32, 32..64]);
-        assert_eq!(ranges(5, 2), [0..2, 2..5]);
-        assert_eq!(ranges(3, 8), [0..1, 1..2, 2..3]);
-        assert!(ranges(0, 2).is_empty());
+    fn a_lone_thread_takes_the_full_batches_then_the_whole_tail() {
+        let taken = takes(&Schedule::new(400, 32), &[0]);
+        let ranges: Vec<_> = taken.into_iter().map(|(_, range)| range).collect();
+        let mut expected: Vec<_> = (0..12).map(|b| b * 32..(b + 1) * 32).collect();
+        expected.push(384..400);
+        assert_eq!(ranges, expected);
+        assert!(takes(&Schedule::new(0, 32), &[0]).is_empty());
+        assert_eq!(takes(&Schedule::new(5, 32), &[0]), [(0, 0..5)]);
+    }
+
+    #[test]
+    fn threads_that_all_reach_the_tail_share_it_evenly() {
+        // Two threads, taking in turn: six full batches each, then half the tail each.
+        let taken = takes(&Schedule::new(400, 32), &[0, 1]);
+        assert_eq!(taken[..12].iter().filter(|(t, _)| *t == 0).count(), 6);
+        assert_eq!(taken[12..], [(0, 384..392), (1, 392..400)]);
+        // Three threads and a tail of 7: 3, 2 and 2.
+        let taken = takes(&Schedule::new(7, 32), &[0, 1, 2]);
+        assert_eq!(taken, [(0, 0..3), (1, 3..5), (2, 5..7)]);
+    }
+
+    #[test]
+    fn a_thread_back_before_the_others_takes_its_share_of_what_is_left() {
+        let schedule = Schedule::new(48, 32);
+        let (mut first, mut second) = (false, false);
+        schedule.join();
+        schedule.join();
+        assert_eq!(schedule.take(&mut first), Some(0..32));
+        // Thread 0 reaches the tail first, and again before thread 1.
+        assert_eq!(schedule.take(&mut first), Some(32..40));
+        assert_eq!(schedule.take(&mut first), Some(40..44));
+        assert_eq!(schedule.take(&mut second), Some(44..48));
+        assert_eq!(schedule.take(&mut second), None);
+        assert_eq!(schedule.take(&mut first), None);
+    }
+
+    #[test]
+    fn a_thread_that_joins_late_finds_the_tail_taken() {
+        let schedule = Schedule::new(7, 32);
+        let (mut first, mut second) = (false, false);
+        schedule.join();
+        assert_eq!(schedule.take(&mut first), Some(0..7));
+        schedule.join();
+        assert_eq!(schedule.take(&mut second), None);
+    }
+
+    #[test]
+    fn the_tail_is_always_taken_whole_and_once() {
+        for networks in 0..100 {
+            for threads in 1..5 {
+                let order: Vec<usize> = (0..threads).collect();
+                let mut ranges: Vec<_> = takes(&Schedule::new(networks, 8), &order)
+                    .into_iter()
+                    .map(|(_, range)| range)
+                    .collect();
+                ranges.sort_by_key(|range| range.start);
+                let covered: Vec<usize> = ranges.into_iter().flatten().collect();
+                assert_eq!(
+                    covered,
+                    (0..networks).collect::<Vec<_>>(),
+                    "{networks} networks, {threads} threads"
+                );
+            }
+        }
     }
 
     #[test]

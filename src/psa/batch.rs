@@ -47,9 +47,9 @@ pub const LANES: usize = 32;
 /// overall than 8 lanes.
 pub const NARROW_LANES: usize = 16;
 /// The kernel's width for a remainder of at most this many networks: one
-/// AVX-512 register per value. On two threads, the 16 networks left of the
-/// baseline ESP's 400 go one piece of 8 to each thread; in a narrow block,
-/// half of its lanes would fly for nothing.
+/// AVX-512 register per value. On two threads that both reach the tail,
+/// the 16 networks left of the baseline ESP's 400 go one piece of 8 to
+/// each thread; in a narrow block, half of its lanes would fly for nothing.
 pub const SMALL_LANES: usize = 8;
 
 /// The weights of a block of networks, lane by lane. Lesioned hidden
