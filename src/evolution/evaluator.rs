@@ -158,17 +158,19 @@ const KEEP_WARM: Duration = Duration::from_millis(2);
 
 /// Which networks each thread evaluates next: first the full batches of
 /// `size`, one at a time, then the tail, the fewer than `size` networks
-/// left, shared out among the threads still to reach it.
+/// left, shared out among the threads that reach it.
 ///
-/// The tail is cut when a thread reaches it, not beforehand: a thread takes
-/// its share of what is left, counting itself and every thread that is
-/// still taking batches and has not yet had a piece of the tail, so that
-/// the threads finish together when they all take part; a thread alone
-/// (in `replicate`, where every thread runs a run of its own, the helpers
-/// rarely come) takes all of it in one batch instead of several smaller
-/// ones, each about as slow as the whole when the batch is too narrow to
-/// fill the SIMD units. A thread that comes back for more takes its share
-/// again, at least one network, so the tail is always taken whole.
+/// The tail is cut when a thread reaches it, not beforehand: the thread
+/// takes its share of what is left, counting itself and every thread that
+/// is still taking batches and has not yet had a piece of the tail, so
+/// that the threads finish together when they all take part. A thread
+/// alone (in `replicate`, where every thread runs a run of its own, the
+/// helpers rarely come) takes all of it in one batch instead of several
+/// smaller ones, each about as slow as the whole when a batch is too
+/// narrow to fill the SIMD units. A thread that comes back after its piece
+/// leaves the rest to the threads still to share, for the same reason;
+/// once none is left (one that panicked included, see [`Taker`]), it takes
+/// what remains.
 #[derive(Debug)]
 struct Schedule {
     size: usize,
@@ -192,38 +194,66 @@ impl Schedule {
             still_to_share: AtomicUsize::new(0),
         }
     }
+}
 
-    /// Counts a thread in among those that will take batches.
-    fn join(&self) {
-        self.still_to_share.fetch_add(1, Ordering::AcqRel);
+/// One thread's view of a [`Schedule`]: counted among the threads still to
+/// share the tail from its making until it has had a piece of the tail or
+/// is dropped (so a thread that panics leaves the rest to the others).
+struct Taker<'a> {
+    schedule: &'a Schedule,
+    shared: bool,
+}
+
+impl<'a> Taker<'a> {
+    fn new(schedule: &'a Schedule) -> Taker<'a> {
+        schedule.still_to_share.fetch_add(1, Ordering::AcqRel);
+        Taker {
+            schedule,
+            shared: false,
+        }
     }
 
-    /// The next batch for a thread that has [joined](Schedule::join);
-    /// `shared` says whether it has had a piece of the tail yet. `None`
-    /// when every network is taken.
-    fn take(&self, shared: &mut bool) -> Option<Range<usize>> {
-        let batch = self.next_batch.fetch_add(1, Ordering::AcqRel);
-        if batch < self.networks / self.size {
-            return Some(batch * self.size..(batch + 1) * self.size);
+    /// The next batch for this thread: `None` when every network is taken,
+    /// or when this thread has had its piece of the tail and others are
+    /// still to have theirs.
+    fn next(&mut self) -> Option<Range<usize>> {
+        let schedule = self.schedule;
+        let full = schedule.networks / schedule.size;
+        if schedule.next_batch.load(Ordering::Acquire) < full {
+            let batch = schedule.next_batch.fetch_add(1, Ordering::AcqRel);
+            if batch < full {
+                return Some(batch * schedule.size..(batch + 1) * schedule.size);
+            }
         }
-        // This thread, and the others still to share.
-        let takers = if *shared {
-            self.still_to_share.load(Ordering::Acquire) + 1
+        let takers = if self.shared {
+            if schedule.still_to_share.load(Ordering::Acquire) > 0 {
+                return None;
+            }
+            1
         } else {
-            *shared = true;
-            self.still_to_share.fetch_sub(1, Ordering::AcqRel)
+            self.shared = true;
+            // This thread and the others still to share.
+            schedule.still_to_share.fetch_sub(1, Ordering::AcqRel)
         };
-        let mut start = self.next_in_tail.load(Ordering::Acquire);
+        let mut start = schedule.next_in_tail.load(Ordering::Acquire);
         loop {
-            let left = self.networks.checked_sub(start).filter(|&left| left > 0)?;
-            let end = start + left.div_ceil(takers.max(1));
-            match self
+            let left = schedule.networks.checked_sub(start).filter(|&left| left > 0)?;
+            let end = start + left.div_ceil(takers);
+            match schedule
                 .next_in_tail
                 .compare_exchange(start, end, Ordering::AcqRel, Ordering::Acquire)
             {
                 Ok(_) => return Some(start..end),
                 Err(now) => start = now,
             }
+        }
+    }
+}
+
+impl Drop for Taker<'_> {
+    fn drop(&mut self) {
+        if !self.shared {
+            self.schedule.still_to_share.fetch_sub(1, Ordering::AcqRel);
         }
     }
 }
@@ -250,18 +280,27 @@ impl Drop for CountDone<'_> {
 }
 
 impl<S: NetworkSet + ?Sized> Batches<'_, S> {
-    /// Takes and evaluates batches until none is left.
-    fn take_and_run<E: Evaluator>(&self, evaluator: &E, streams: &StreamFamily) {
+    /// Takes and evaluates batches until none is left for this thread;
+    /// the `caller` goes on until every network is evaluated, taking what
+    /// the others leave, and yields its core while it waits.
+    fn take_and_run<E: Evaluator>(&self, evaluator: &E, streams: &StreamFamily, caller: bool) {
         let mut worker = None;
-        let mut shared = false;
-        self.schedule.join();
-        while let Some(range) = self.schedule.take(&mut shared) {
-            let _done = CountDone(&self.done, range.len());
-            let result = self.evaluate(evaluator, &mut worker, range.clone(), streams);
-            self.results
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner)
-                .push((range.start, result));
+        let mut taker = Taker::new(&self.schedule);
+        loop {
+            match taker.next() {
+                Some(range) => {
+                    let _done = CountDone(&self.done, range.len());
+                    let result = self.evaluate(evaluator, &mut worker, range.clone(), streams);
+                    self.results
+                        .lock()
+                        .unwrap_or_else(PoisonError::into_inner)
+                        .push((range.start, result));
+                }
+                None if caller && self.done.load(Ordering::Acquire) < self.schedule.networks => {
+                    std::thread::yield_now()
+                }
+                None => return,
+            }
         }
     }
 
@@ -326,12 +365,9 @@ fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
     let helpers = threads.min(full + tail.min(threads)).saturating_sub(1);
     rayon::scope(|scope| {
         for _ in 0..helpers {
-            scope.spawn(|_| batches.take_and_run(evaluator, streams));
+            scope.spawn(|_| batches.take_and_run(evaluator, streams, false));
         }
-        batches.take_and_run(evaluator, streams);
-        while batches.done.load(Ordering::Acquire) < networks.len() {
-            std::thread::yield_now();
-        }
+        batches.take_and_run(evaluator, streams, true);
     });
     for _ in 0..helpers {
         keep_warm();
@@ -429,27 +465,23 @@ mod tests {
         panic_from: None,
     };
 
-    /// Every batch `schedule` gives the threads, which all join first,
-    /// `order` naming which thread takes next, until every thread has found
-    /// nothing left.
+    /// Every batch `schedule` gives the threads, which all start together,
+    /// `order` naming which thread asks next, until none gets anything.
     fn takes(schedule: &Schedule, order: &[usize]) -> Vec<(usize, Range<usize>)> {
         let threads = order.iter().max().map_or(0, |&t| t + 1);
-        (0..threads).for_each(|_| schedule.join());
-        let (mut shared, mut finished) = (vec![false; threads], vec![false; threads]);
+        let mut takers: Vec<Taker> = (0..threads).map(|_| Taker::new(schedule)).collect();
         let mut taken = Vec::new();
-        for &t in order.iter().cycle() {
-            if finished.iter().all(|&f| f) {
-                break;
+        loop {
+            let before = taken.len();
+            for &t in order {
+                if let Some(range) = takers[t].next() {
+                    taken.push((t, range));
+                }
             }
-            if finished[t] {
-                continue;
-            }
-            match schedule.take(&mut shared[t]) {
-                Some(range) => taken.push((t, range)),
-                None => finished[t] = true,
+            if taken.len() == before {
+                return taken;
             }
         }
-        taken
     }
 
     #[test]
@@ -465,7 +497,7 @@ mod tests {
 
     #[test]
     fn threads_that_all_reach_the_tail_share_it_evenly() {
-        // Two threads, taking in turn: six full batches each, then half the tail each.
+        // Two threads, asking in turn: six full batches each, then half the tail each.
         let taken = takes(&Schedule::new(400, 32), &[0, 1]);
         assert_eq!(taken[..12].iter().filter(|(t, _)| *t == 0).count(), 6);
         assert_eq!(taken[12..], [(0, 384..392), (1, 392..400)]);
@@ -475,28 +507,37 @@ mod tests {
     }
 
     #[test]
-    fn a_thread_back_before_the_others_takes_its_share_of_what_is_left() {
+    fn a_thread_back_before_the_others_leaves_them_their_share() {
         let schedule = Schedule::new(48, 32);
-        let (mut first, mut second) = (false, false);
-        schedule.join();
-        schedule.join();
-        assert_eq!(schedule.take(&mut first), Some(0..32));
-        // Thread 0 reaches the tail first, and again before thread 1.
-        assert_eq!(schedule.take(&mut first), Some(32..40));
-        assert_eq!(schedule.take(&mut first), Some(40..44));
-        assert_eq!(schedule.take(&mut second), Some(44..48));
-        assert_eq!(schedule.take(&mut second), None);
-        assert_eq!(schedule.take(&mut first), None);
+        let (mut first, mut second) = (Taker::new(&schedule), Taker::new(&schedule));
+        assert_eq!(first.next(), Some(0..32));
+        assert_eq!(first.next(), Some(32..40));
+        // The second thread has not had its piece yet.
+        assert_eq!(first.next(), None);
+        assert_eq!(second.next(), Some(40..48));
+        assert_eq!(second.next(), None);
+        assert_eq!(first.next(), None);
     }
 
     #[test]
-    fn a_thread_that_joins_late_finds_the_tail_taken() {
+    fn a_thread_that_comes_late_finds_the_tail_taken() {
         let schedule = Schedule::new(7, 32);
-        let (mut first, mut second) = (false, false);
-        schedule.join();
-        assert_eq!(schedule.take(&mut first), Some(0..7));
-        schedule.join();
-        assert_eq!(schedule.take(&mut second), None);
+        let mut first = Taker::new(&schedule);
+        assert_eq!(first.next(), Some(0..7));
+        assert_eq!(Taker::new(&schedule).next(), None);
+    }
+
+    #[test]
+    fn the_rest_of_a_thread_that_drops_out_goes_to_the_others() {
+        let schedule = Schedule::new(48, 32);
+        let mut first = Taker::new(&schedule);
+        let second = Taker::new(&schedule);
+        assert_eq!(first.next(), Some(0..32));
+        assert_eq!(first.next(), Some(32..40));
+        assert_eq!(first.next(), None);
+        drop(second); // as when its thread panics
+        assert_eq!(first.next(), Some(40..48));
+        assert_eq!(first.next(), None);
     }
 
     #[test]
