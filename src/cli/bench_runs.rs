@@ -174,6 +174,9 @@ impl Evaluator for Timed<'_> {
     fn batch_size(&self) -> usize {
         self.inner.batch_size()
     }
+    fn narrowest_batch(&self) -> usize {
+        self.inner.narrowest_batch()
+    }
     fn evaluate_batch<S: NetworkSet + ?Sized>(
         &self,
         worker: &mut Self::Worker,

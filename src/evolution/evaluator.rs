@@ -33,6 +33,16 @@ pub trait Evaluator: Sync {
         1
     }
 
+    /// The fewest networks worth a batch of their own, at most
+    /// [`Evaluator::batch_size`]: a batch of fewer takes about as long as
+    /// one of this many, so the networks left after the full batches are
+    /// not cut into smaller pieces for the threads to share (see
+    /// [`evaluate_all`]). 1 (the default) lets them be cut as fine as the
+    /// thread count asks.
+    fn narrowest_batch(&self) -> usize {
+        1
+    }
+
     /// The fitness of networks `range` of `networks`, network `j` with the
     /// stream `streams.stream(j)`: what [`Evaluator::evaluate`] gives each,
     /// bit for bit. The default calls it network by network; a batched
@@ -163,8 +173,10 @@ const KEEP_WARM: Duration = Duration::from_millis(2);
 /// The tail is cut when a thread reaches it, not beforehand: the thread
 /// takes its share of what is left, counting itself and every thread that
 /// is still taking batches and has not yet had a piece of the tail, so
-/// that the threads finish together when they all take part. A thread
-/// alone (in `replicate`, where every thread runs a run of its own, the
+/// that the threads finish together when they all take part, but never
+/// in pieces of fewer than `narrowest` networks (see
+/// [`Evaluator::narrowest_batch`]): the first thread there takes all of a
+/// tail that narrow. A thread alone (in `replicate`, where every thread runs a run of its own, the
 /// helpers rarely come) takes all of it in one batch instead of several
 /// smaller ones, each about as slow as the whole when a batch is too
 /// narrow to fill the SIMD units. A thread that comes back after its piece
@@ -174,6 +186,8 @@ const KEEP_WARM: Duration = Duration::from_millis(2);
 #[derive(Debug)]
 struct Schedule {
     size: usize,
+    /// The fewest networks of a piece of the tail (unless fewer are left).
+    narrowest: usize,
     networks: usize,
     /// The next full batch to take.
     next_batch: AtomicUsize,
@@ -184,10 +198,11 @@ struct Schedule {
 }
 
 impl Schedule {
-    fn new(networks: usize, size: usize) -> Schedule {
+    fn new(networks: usize, size: usize, narrowest: usize) -> Schedule {
         let size = size.max(1);
         Schedule {
             size,
+            narrowest: narrowest.clamp(1, size),
             networks,
             next_batch: AtomicUsize::new(0),
             next_in_tail: AtomicUsize::new(networks / size * size),
@@ -238,7 +253,7 @@ impl<'a> Taker<'a> {
         let mut start = schedule.next_in_tail.load(Ordering::Acquire);
         loop {
             let left = schedule.networks.checked_sub(start).filter(|&left| left > 0)?;
-            let end = start + left.div_ceil(takers);
+            let end = start + left.div_ceil(takers).max(schedule.narrowest).min(left);
             match schedule
                 .next_in_tail
                 .compare_exchange(start, end, Ordering::AcqRel, Ordering::Acquire)
@@ -356,7 +371,7 @@ fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
     let size = evaluator.batch_size();
     let batches = Batches {
         networks,
-        schedule: Schedule::new(networks.len(), size),
+        schedule: Schedule::new(networks.len(), size, evaluator.narrowest_batch()),
         done: AtomicUsize::new(0),
         results: Mutex::new(Vec::new()),
     };
@@ -486,29 +501,37 @@ mod tests {
 
     #[test]
     fn a_lone_thread_takes_the_full_batches_then_the_whole_tail() {
-        let taken = takes(&Schedule::new(400, 32), &[0]);
+        let taken = takes(&Schedule::new(400, 32, 1), &[0]);
         let ranges: Vec<_> = taken.into_iter().map(|(_, range)| range).collect();
         let mut expected: Vec<_> = (0..12).map(|b| b * 32..(b + 1) * 32).collect();
         expected.push(384..400);
         assert_eq!(ranges, expected);
-        assert!(takes(&Schedule::new(0, 32), &[0]).is_empty());
-        assert_eq!(takes(&Schedule::new(5, 32), &[0]), [(0, 0..5)]);
+        assert!(takes(&Schedule::new(0, 32, 1), &[0]).is_empty());
+        assert_eq!(takes(&Schedule::new(5, 32, 1), &[0]), [(0, 0..5)]);
     }
 
     #[test]
     fn threads_that_all_reach_the_tail_share_it_evenly() {
         // Two threads, asking in turn: six full batches each, then half the tail each.
-        let taken = takes(&Schedule::new(400, 32), &[0, 1]);
+        let taken = takes(&Schedule::new(400, 32, 1), &[0, 1]);
         assert_eq!(taken[..12].iter().filter(|(t, _)| *t == 0).count(), 6);
         assert_eq!(taken[12..], [(0, 384..392), (1, 392..400)]);
         // Three threads and a tail of 7: 3, 2 and 2.
-        let taken = takes(&Schedule::new(7, 32), &[0, 1, 2]);
+        let taken = takes(&Schedule::new(7, 32, 1), &[0, 1, 2]);
         assert_eq!(taken, [(0, 0..3), (1, 3..5), (2, 5..7)]);
     }
 
     #[test]
+    fn the_tail_is_not_cut_narrower_than_the_evaluator_asks() {
+        let taken = takes(&Schedule::new(400, 32, 16), &[0, 1]);
+        assert_eq!(taken[12..], [(0, 384..400)]);
+        let taken = takes(&Schedule::new(20, 32, 8), &[0, 1, 2]);
+        assert_eq!(taken, [(0, 0..8), (1, 8..16), (2, 16..20)]);
+    }
+
+    #[test]
     fn a_thread_back_before_the_others_leaves_them_their_share() {
-        let schedule = Schedule::new(48, 32);
+        let schedule = Schedule::new(48, 32, 1);
         let (mut first, mut second) = (Taker::new(&schedule), Taker::new(&schedule));
         assert_eq!(first.next(), Some(0..32));
         assert_eq!(first.next(), Some(32..40));
@@ -521,7 +544,7 @@ mod tests {
 
     #[test]
     fn a_thread_that_comes_late_finds_the_tail_taken() {
-        let schedule = Schedule::new(7, 32);
+        let schedule = Schedule::new(7, 32, 1);
         let mut first = Taker::new(&schedule);
         assert_eq!(first.next(), Some(0..7));
         assert_eq!(Taker::new(&schedule).next(), None);
@@ -529,7 +552,7 @@ mod tests {
 
     #[test]
     fn the_rest_of_a_thread_that_drops_out_goes_to_the_others() {
-        let schedule = Schedule::new(48, 32);
+        let schedule = Schedule::new(48, 32, 1);
         let mut first = Taker::new(&schedule);
         let second = Taker::new(&schedule);
         assert_eq!(first.next(), Some(0..32));
@@ -542,10 +565,10 @@ mod tests {
 
     #[test]
     fn the_tail_is_always_taken_whole_and_once() {
-        for networks in 0..100 {
+        for (networks, narrowest) in (0..100).flat_map(|n| [(n, 1), (n, 3), (n, 8)]) {
             for threads in 1..5 {
                 let order: Vec<usize> = (0..threads).collect();
-                let mut ranges: Vec<_> = takes(&Schedule::new(networks, 8), &order)
+                let mut ranges: Vec<_> = takes(&Schedule::new(networks, 8, narrowest), &order)
                     .into_iter()
                     .map(|(_, range)| range)
                     .collect();
@@ -554,7 +577,7 @@ mod tests {
                 assert_eq!(
                     covered,
                     (0..networks).collect::<Vec<_>>(),
-                    "{networks} networks, {threads} threads"
+                    "{networks} networks, {threads} threads, pieces of at least {narrowest}"
                 );
             }
         }

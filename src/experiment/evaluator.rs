@@ -112,6 +112,9 @@ impl Evaluator for PsaEvaluator {
             1
         }
     }
+    fn narrowest_batch(&self) -> usize {
+        self.batch.as_ref().map_or(1, BatchRunner::narrowest_block)
+    }
     fn evaluate_batch<S: NetworkSet + ?Sized>(
         &self,
         worker: &mut PsaWorker,

@@ -384,6 +384,24 @@ impl BatchRunner {
         self.level
     }
 
+    /// The fewest networks worth a block of their own on this runner's
+    /// SIMD level. On AVX-512 a block of [`SMALL_LANES`] networks, one
+    /// register per value, is bound by the latency of a step's long
+    /// dependency chain and takes longer than one of [`NARROW_LANES`];
+    /// on AVX2 (two registers per value) and the portable build it takes
+    /// less. Measured on Zen 5 (`psa-esp bench --steps 500 --rounds 7
+    /// --networks 8`, and `16`, two runs each): AVX-512 27.9-33.0 against
+    /// 11.5-11.6 ns per network-step, so 8 networks take 1.2-1.4 times as
+    /// long as 16; AVX2 32.6-34.5 against 22.1-22.8 ns, about three
+    /// quarters as long.
+    pub fn narrowest_block(&self) -> usize {
+        if self.level == SimdLevel::Avx512 && self.level.is_supported() {
+            NARROW_LANES
+        } else {
+            SMALL_LANES
+        }
+    }
+
     /// The fitness of networks `range` of `networks`, in % of the
     /// theoretical maximum, the mean over `settings.trials` trials: exactly
     /// what [`TrialRunner::evaluate`] gives network `range.start + i` with
