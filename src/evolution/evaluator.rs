@@ -170,19 +170,17 @@ const KEEP_WARM: Duration = Duration::from_millis(2);
 /// `size`, one at a time, then the tail, the fewer than `size` networks
 /// left, shared out among the threads that reach it.
 ///
-/// The tail is cut when a thread reaches it, not beforehand: the thread
+/// The tail is cut when a thread reaches it, not beforehand. The thread
 /// takes its share of what is left, counting itself and every thread that
 /// is still taking batches and has not yet had a piece of the tail, so
-/// that the threads finish together when they all take part, but never
-/// in pieces of fewer than `narrowest` networks (see
-/// [`Evaluator::narrowest_batch`]): the first thread there takes all of a
-/// tail that narrow. A thread alone (in `replicate`, where every thread runs a run of its own, the
-/// helpers rarely come) takes all of it in one batch instead of several
-/// smaller ones, each about as slow as the whole when a batch is too
-/// narrow to fill the SIMD units. A thread that comes back after its piece
-/// leaves the rest to the threads still to share, for the same reason;
-/// once none is left (one that panicked included, see [`Taker`]), it takes
-/// what remains.
+/// that the threads finish together when they all take part; but never a
+/// piece of fewer than `narrowest` networks (see
+/// [`Evaluator::narrowest_batch`]), so the first thread there takes all of
+/// a tail that narrow. A thread alone (in `replicate`, where every thread
+/// runs a run of its own, the helpers rarely come) takes all of the tail
+/// in one batch. A thread that comes back after its piece leaves the rest
+/// to the threads still to have theirs; once there are none (one that
+/// panicked included, see [`Taker`]), it takes what remains.
 #[derive(Debug)]
 struct Schedule {
     size: usize,
@@ -368,14 +366,14 @@ fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
 ) -> Result<Vec<f64>> {
     BATCH_CALLS.fetch_add(1, Ordering::AcqRel);
     let threads = rayon::current_num_threads();
-    let size = evaluator.batch_size();
     let batches = Batches {
         networks,
-        schedule: Schedule::new(networks.len(), size, evaluator.narrowest_batch()),
+        schedule: Schedule::new(networks.len(), evaluator.batch_size(), evaluator.narrowest_batch()),
         done: AtomicUsize::new(0),
         results: Mutex::new(Vec::new()),
     };
     // No more helpers than batches could keep busy.
+    let size = batches.schedule.size;
     let (full, tail) = (networks.len() / size, networks.len() % size);
     let helpers = threads.min(full + tail.min(threads)).saturating_sub(1);
     rayon::scope(|scope| {
