@@ -34,7 +34,7 @@ pub trait Evaluator: Sync {
     }
 
     /// The fewest networks worth a batch of their own, at most
-    /// [`Evaluator::batch_size`]: a batch of fewer takes about as long as
+    /// [`Evaluator::batch_size`]: a batch of fewer takes at least as long as
     /// one of this many, so the networks left after the full batches are
     /// not cut into smaller pieces for the threads to share (see
     /// [`evaluate_all`]). 1 (the default) lets them be cut as fine as the
