@@ -28,19 +28,19 @@ const HIDDEN: usize = 5;
 /// Arguments of `bench`.
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
-    /// Physics steps per backend and round.
-    #[arg(long, default_value_t = 50_000, value_parser = clap::value_parser!(u64).range(500..))]
+    /// Physics steps per backend and round (at most 1e9).
+    #[arg(long, default_value_t = 50_000, value_parser = clap::value_parser!(u64).range(500..=1_000_000_000))]
     pub steps: u64,
-    /// Interleaved rounds; the median round is reported.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..))]
+    /// Interleaved rounds; the median round is reported (at most 1000).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub rounds: u64,
-    /// Networks per round of the evaluation benchmark.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..))]
+    /// Networks per round of the evaluation benchmark (at most 100,000).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub networks: u64,
     /// Generations of the `evolve` and `replicate` scaling runs (5 times
     /// as many for the algorithm overhead). Fewer make runs of a few
-    /// hundredths of a second, whose speed-ups scatter.
-    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(2..))]
+    /// hundredths of a second, whose speed-ups scatter (at most 100,000).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(2..=100_000))]
     pub generations: u64,
     /// Print the results as JSON.
     #[arg(long)]

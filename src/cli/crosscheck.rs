@@ -4,16 +4,21 @@ use anyhow::Result;
 
 use super::{PhysicsArgs, EXIT_CHECK_FAILED};
 use crate::physics::crosscheck;
+use crate::psa::limits::MAX_STEPS;
 use crate::psa::BodySettings;
+
+/// The most random thrust sequences of one cross-check (only time grows with them).
+const MAX_SEQUENCES: u64 = 100_000;
 
 /// Arguments of `crosscheck`.
 #[derive(Debug, clap::Args)]
 pub struct CrosscheckArgs {
-    /// Number of random thrust sequences.
-    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
+    /// Number of random thrust sequences (at most 100,000).
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..=MAX_SEQUENCES))]
     pub sequences: u64,
-    /// Steps per sequence.
-    #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u64).range(1..))]
+    /// Steps per sequence (at most 100,000, as a trial; each sequence's
+    /// trajectories are held in memory).
+    #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u64).range(1..=MAX_STEPS))]
     pub steps: u64,
     /// Seed of the thrust sequences.
     #[arg(long, default_value_t = 1)]

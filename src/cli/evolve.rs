@@ -6,6 +6,7 @@ use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::experiment::{run_evolution, Preset};
+use crate::ode::MAX_THREADS;
 use crate::physics::BackendKind;
 use crate::psa::Task;
 
@@ -30,9 +31,9 @@ pub struct EvolveArgs {
     /// Physics backend, overriding the configuration.
     #[arg(long, value_enum)]
     pub backend: Option<BackendKind>,
-    /// Worker threads (0 = one per core). Results do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
+    /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
+    pub threads: u64,
     /// Output directory (default: evolve-<preset>-task<T>-seed<S>).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -79,7 +80,7 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
         config.generations() as u64,
         "{spinner} generation {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
     );
-    let pool = crate::ode::thread_pool(args.threads)?;
+    let pool = crate::ode::thread_pool(args.threads as usize)?;
     let outcome = pool.install(|| {
         run_evolution(&config, args.preset.name(), args.task, args.seed, &out, |record| {
             bar.set_position(record.generation as u64);

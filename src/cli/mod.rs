@@ -82,9 +82,11 @@ pub struct PhysicsArgs {
 }
 
 impl PhysicsArgs {
-    /// The step settings these options describe.
+    /// The step settings these options describe; `--dt` must be in the
+    /// range of `physics.dt` ([`crate::psa::limits`]).
     pub fn settings(&self) -> anyhow::Result<crate::physics::StepSettings> {
         use crate::physics::{PlaneConstraint, StepSettings, Stepper};
+        crate::psa::limits::check_as("physics.dt", "--dt", self.dt).map_err(anyhow::Error::msg)?;
         let settings = StepSettings {
             dt: self.dt,
             stepper: if self.stepper == "quick" {
@@ -104,29 +106,45 @@ impl PhysicsArgs {
     }
 }
 
-/// A trajectory as CSV: `t,x,y,heading,vx,vy,omega` (SI units), then the
-/// columns named in `extra_header` (which starts with a comma when not
-/// empty) filled per row by `extra(row)`.
+/// The header of a trajectory CSV: `t,x,y,heading,vx,vy,omega` (SI
+/// units), then the columns named in `extra_header` (which starts with a
+/// comma when not empty).
+pub const TRAJECTORY_HEADER: &str = "t,x,y,heading,vx,vy,omega";
+
+/// Row `i` of a trajectory CSV (state `s` at time `i dt`), with `extra`
+/// appended.
+pub fn trajectory_row(
+    out: &mut impl std::fmt::Write,
+    i: u64,
+    dt: f64,
+    s: &crate::physics::BodyState,
+    extra: &str,
+) -> std::fmt::Result {
+    writeln!(
+        out,
+        "{},{},{},{},{},{},{}{extra}",
+        i as f64 * dt,
+        s.x,
+        s.y,
+        s.heading,
+        s.vx,
+        s.vy,
+        s.omega
+    )
+}
+
+/// A trajectory as CSV: [`TRAJECTORY_HEADER`], then the columns named in
+/// `extra_header` (which starts with a comma when not empty) filled per row
+/// by `extra(row)`.
 pub fn trajectory_csv(
     states: &[crate::physics::BodyState],
     dt: f64,
     extra_header: &str,
     extra: impl Fn(usize) -> String,
 ) -> String {
-    let mut csv = format!("t,x,y,heading,vx,vy,omega{extra_header}\n");
+    let mut csv = format!("{TRAJECTORY_HEADER}{extra_header}\n");
     for (i, s) in states.iter().enumerate() {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{},{}{}",
-            i as f64 * dt,
-            s.x,
-            s.y,
-            s.heading,
-            s.vx,
-            s.vy,
-            s.omega,
-            extra(i)
-        );
+        let _ = trajectory_row(&mut csv, i as u64, dt, s, &extra(i));
     }
     csv
 }

@@ -8,6 +8,7 @@ use serde::Serialize;
 use crate::experiment::robustness::TrialSummary;
 use crate::physics::BackendKind;
 use crate::plots::{write_trial_pictures, TrialPicture};
+use crate::psa::limits::{check_as, MAX_TRIALS};
 use crate::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
 
 /// Key of the random stream of replays.
@@ -33,8 +34,8 @@ pub struct ReplayArgs {
     /// Random initial conditions (tasks 1 and 3).
     #[arg(long)]
     pub random_init: bool,
-    /// Number of trials; the fitness is their mean.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    /// Number of trials (at most 1,000,000); the fitness is their mean.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=MAX_TRIALS))]
     pub trials: u64,
     /// Seed of the noise and random initial conditions.
     #[arg(long, default_value_t = 1)]
@@ -95,6 +96,8 @@ fn write_outputs(dir: &Path, record: &TrialRecord, settings: &PsaSettings, title
 
 /// Runs `replay`.
 pub fn run(args: ReplayArgs) -> Result<i32> {
+    check_as("noise.input_sd", "--input-noise", args.input_noise).map_err(anyhow::Error::msg)?;
+    check_as("noise.output_sd", "--output-noise", args.output_noise).map_err(anyhow::Error::msg)?;
     let (file, network) = NetworkFile::load(&args.network)?;
     let task = args.task.unwrap_or(file.task);
     if args.random_init && !task.has_random_init() {

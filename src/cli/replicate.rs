@@ -6,10 +6,13 @@ use std::sync::Mutex;
 use anyhow::Result;
 
 use super::evolve::progress_bar;
-use crate::experiment::grid::{GridPreset, GridSpec};
+use crate::evolution::MAX_GENERATIONS;
+use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
 use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress};
 use crate::experiment::GridConfig;
+use crate::ode::MAX_THREADS;
 use crate::physics::BackendKind;
+use crate::psa::limits::MAX_TRIALS;
 use crate::psa::Task;
 
 /// Arguments of `replicate`.
@@ -27,21 +30,21 @@ pub struct ReplicateArgs {
     /// Tasks, comma-separated (default: 1,2,3).
     #[arg(long, value_delimiter = ',')]
     pub tasks: Option<Vec<Task>>,
-    /// Seeds per configuration and task (seeds 1..=N).
-    #[arg(long)]
+    /// Seeds per configuration and task (seeds 1..=N, at most 10,000).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_SEEDS))]
     pub seeds: Option<u64>,
-    /// Generations (ESP) or cycles (hill-climber) per run.
-    #[arg(long)]
-    pub generations: Option<usize>,
+    /// Generations (ESP) or cycles (hill-climber) per run (at most 1,000,000).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_GENERATIONS as u64))]
+    pub generations: Option<u64>,
     /// Physics backend.
     #[arg(long, value_enum)]
     pub backend: Option<BackendKind>,
-    /// Trials of each robustness test.
-    #[arg(long)]
-    pub robustness_trials: Option<usize>,
-    /// Worker threads (0 = one per core). Results do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    pub jobs: usize,
+    /// Trials of each robustness test (at most 1,000,000).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_TRIALS))]
+    pub robustness_trials: Option<u64>,
+    /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
+    pub jobs: u64,
     /// The grid's directory; running the same command again resumes it.
     #[arg(long)]
     pub out: PathBuf,
@@ -58,9 +61,9 @@ impl ReplicateArgs {
             spec.tasks = t.clone();
         }
         spec.seeds = self.seeds.unwrap_or(spec.seeds);
-        spec.generations = self.generations.unwrap_or(spec.generations);
+        spec.generations = self.generations.map_or(spec.generations, |g| g as usize);
         spec.backend = self.backend.unwrap_or(spec.backend);
-        spec.robustness_trials = self.robustness_trials.unwrap_or(spec.robustness_trials);
+        spec.robustness_trials = self.robustness_trials.map_or(spec.robustness_trials, |t| t as usize);
         spec
     }
 }
@@ -100,7 +103,7 @@ pub fn run(args: ReplicateArgs) -> Result<i32> {
         ),
         best: Mutex::new(f64::NEG_INFINITY),
     };
-    let summary = replicate(&args.out, &spec, args.jobs, &progress)?;
+    let summary = replicate(&args.out, &spec, args.jobs as usize, &progress)?;
     progress.bar.finish_and_clear();
     say!(
         "grid {} ({}): {} runs, {} already finished, {} run now in {:.0} s",

@@ -1,12 +1,13 @@
 //! `psa-esp simulate`: the PSA under given thrust, trajectory as CSV.
 
+use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 
-use super::PhysicsArgs;
-use crate::physics::{create_backend, trajectory, BackendKind, BodyState};
-use crate::psa::{BodySettings, THRUSTER_COUNT};
+use super::{PhysicsArgs, TRAJECTORY_HEADER};
+use crate::physics::{create_backend, for_each_state, BackendKind, BodyState, PhysicsBackend};
+use crate::psa::{limits, BodySettings, THRUSTER_COUNT};
 
 /// Arguments of `simulate`.
 #[derive(Debug, clap::Args)]
@@ -27,9 +28,10 @@ pub struct SimulateArgs {
     /// whitespace separated; '#' starts a comment).
     #[arg(long)]
     pub thrust_file: Option<PathBuf>,
-    /// Number of steps (default 500 with --thrust; the file's rows with --thrust-file).
-    #[arg(long)]
-    pub steps: Option<usize>,
+    /// Number of steps (default 500 with --thrust; the file's rows with
+    /// --thrust-file), at most 1e9. The trajectory is written as it goes.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(0..=MAX_STEPS))]
+    pub steps: Option<u64>,
     /// Start state x,y,heading,vx,vy,omega (m, rad, m/s, rad/s).
     #[arg(
         long,
@@ -46,10 +48,14 @@ pub struct SimulateArgs {
 }
 
 /// The default number of steps of a trial (`[chosen]` 500 x 0.05 s = 25 s).
-const DEFAULT_STEPS: usize = 500;
+const DEFAULT_STEPS: u64 = 500;
+
+/// The most steps of one simulation: about 100 GB of CSV and an hour or two
+/// of ODE; the trajectory is streamed, so only time and disk grow with it.
+pub const MAX_STEPS: u64 = 1_000_000_000;
 
 fn read_thrust_file(path: &PathBuf) -> Result<Vec<Vec<f64>>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read thrust file {}", path.display()))?;
+    let text = crate::io::read_input(path, "thrust file")?;
     let mut rows = Vec::new();
     for (number, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
@@ -78,7 +84,19 @@ fn read_thrust_file(path: &PathBuf) -> Result<Vec<Vec<f64>>> {
     Ok(rows)
 }
 
-fn commands(args: &SimulateArgs) -> Result<Vec<Vec<f64>>> {
+/// The thrust of every step: `rows` in turn, cycling, `steps` in all.
+struct Commands {
+    rows: Vec<Vec<f64>>,
+    steps: u64,
+}
+
+impl Commands {
+    fn iter(&self) -> impl Iterator<Item = &[f64]> {
+        self.rows.iter().map(Vec::as_slice).cycle().take(self.steps as usize)
+    }
+}
+
+fn commands(args: &SimulateArgs) -> Result<Commands> {
     match (&args.thrust, &args.thrust_file) {
         (Some(thrust), _) => {
             if thrust.len() != THRUSTER_COUNT {
@@ -87,47 +105,100 @@ fn commands(args: &SimulateArgs) -> Result<Vec<Vec<f64>>> {
                     thrust.len()
                 );
             }
-            Ok(vec![thrust.clone(); args.steps.unwrap_or(DEFAULT_STEPS)])
+            Ok(Commands {
+                rows: vec![thrust.clone()],
+                steps: args.steps.unwrap_or(DEFAULT_STEPS),
+            })
         }
         (None, Some(path)) => {
             let mut rows = read_thrust_file(path)?;
             if let Some(steps) = args.steps {
-                if steps > rows.len() {
+                if steps > rows.len() as u64 {
                     bail!("--steps {steps} exceeds the {} rows of {}", rows.len(), path.display());
                 }
-                rows.truncate(steps);
+                rows.truncate(steps as usize);
             }
-            Ok(rows)
+            let steps = rows.len() as u64;
+            Ok(Commands { rows, steps })
         }
         (None, None) => bail!("give --thrust or --thrust-file"),
     }
 }
 
-/// Runs `simulate`.
-pub fn run(args: SimulateArgs) -> Result<i32> {
-    let settings = args.physics.settings()?;
-    let model = BodySettings::default().model()?;
-    let commands = commands(&args)?;
-    let [x, y, heading, vx, vy, omega] = args.start[..] else {
-        bail!("--start takes six values: x,y,heading,vx,vy,omega");
+/// The start state of `--start`, each value in the range of its `start.*`
+/// row of [`limits`].
+fn start_state(values: &[f64]) -> Result<BodyState> {
+    let [x, y, heading, vx, vy, omega] = values[..] else {
+        bail!(
+            "--start takes six values: x,y,heading,vx,vy,omega, got {}",
+            values.len()
+        );
     };
-    let start = BodyState {
+    for (name, value) in ["x", "y", "heading", "vx", "vy", "omega"].iter().zip(values) {
+        limits::check_as(&format!("start.{name}"), &format!("--start {name}"), *value).map_err(anyhow::Error::msg)?;
+    }
+    Ok(BodyState {
         x,
         y,
         heading,
         vx,
         vy,
         omega,
-    };
+    })
+}
+
+/// Writes the trajectory CSV of `commands` from `start` to `out` as the
+/// backend flies it; returns the number of states written.
+fn write_trajectory(
+    out: &mut dyn Write,
+    backend: &mut dyn PhysicsBackend,
+    start: &BodyState,
+    commands: &Commands,
+    dt: f64,
+) -> Result<u64> {
+    writeln!(out, "{TRAJECTORY_HEADER}")?;
+    let mut row = String::new();
+    let mut written = 0;
+    for_each_state(backend, start, commands.iter(), |state| -> Result<()> {
+        row.clear();
+        super::trajectory_row(&mut row, written, dt, state, "")?;
+        out.write_all(row.as_bytes())?;
+        written += 1;
+        Ok(())
+    })?;
+    Ok(written)
+}
+
+/// Runs `simulate`.
+pub fn run(args: SimulateArgs) -> Result<i32> {
+    let settings = args.physics.settings()?;
+    let model = BodySettings::default().model()?;
+    let start = start_state(&args.start)?;
+    let commands = commands(&args)?;
     let mut backend = create_backend(args.backend, &model, &settings)?;
-    let states = trajectory(backend.as_mut(), &start, &commands)?;
-    let csv = super::trajectory_csv(&states, settings.dt, "", |_| String::new());
     match &args.out {
         Some(path) => {
-            crate::io::write_atomic(path, csv.as_bytes())?;
-            eprintln!("wrote {} states to {}", states.len(), path.display());
+            let mut written = 0;
+            crate::io::write_atomic_with(path, |out| {
+                written = write_trajectory(out, backend.as_mut(), &start, &commands, settings.dt)?;
+                Ok(())
+            })?;
+            eprintln!("wrote {written} states to {}", path.display());
         }
-        None => say!("{}", csv.trim_end()),
+        None => {
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            let result = write_trajectory(&mut out, backend.as_mut(), &start, &commands, settings.dt)
+                .and_then(|_| Ok(out.flush()?));
+            if let Err(e) = result {
+                // The reader has gone (`psa-esp simulate ... | head`): done.
+                if e.downcast_ref::<std::io::Error>()
+                    .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+                {
+                    std::process::exit(0);
+                }
+                return Err(e);
+            }
+        }
     }
     Ok(0)
 }

@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 use super::operators::{cauchy, crossover, mutate_one_gene};
 use super::subpop::Subpop;
 use super::{
-    best_of, check_count, check_init_range, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
+    best_of, check_cauchy_limit, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
+    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_SUBPOP_SIZE, MAX_TRIALS_PER_NEURON,
 };
 use super::{Champion, Evaluator, GenerationRecord, LesionOutcome, RunResult};
 use crate::network::{Network, NetworkSet};
@@ -129,19 +130,36 @@ impl Default for EspSettings {
 impl EspSettings {
     /// Rejects out-of-range values, naming the setting.
     pub fn validate(&self) -> Result<(), String> {
-        check_count("esp.subpop_size", self.subpop_size, 4)?;
-        check_count("esp.trials_per_neuron", self.trials_per_neuron, 1)?;
-        check_count("esp.initial_hidden", self.initial_hidden, 1)?;
-        check_count("esp.generations", self.generations, 1)?;
-        check_count("esp.stagnation", self.stagnation, 1)?;
-        check_count("esp.bursts_before_lesion", self.bursts_before_lesion, 1)?;
-        check_init_range("esp.init_range", self.init_range)?;
+        check_count("esp.subpop_size", self.subpop_size, 4, MAX_SUBPOP_SIZE)?;
+        check_count(
+            "esp.trials_per_neuron",
+            self.trials_per_neuron,
+            1,
+            MAX_TRIALS_PER_NEURON,
+        )?;
+        check_count("esp.initial_hidden", self.initial_hidden, 1, MAX_HIDDEN)?;
+        check_count("esp.generations", self.generations, 1, MAX_GENERATIONS)?;
+        check_count("esp.stagnation", self.stagnation, 1, usize::MAX)?;
+        check_count("esp.bursts_before_lesion", self.bursts_before_lesion, 1, usize::MAX)?;
+        check_positive("esp.init_range", self.init_range)?;
         check_positive("esp.mutation_scale", self.mutation_scale)?;
         check_positive("esp.cauchy_limit", self.cauchy_limit)?;
         check_positive("esp.burst_scale", self.burst_scale)?;
         check_probability("esp.mutation_rate", self.mutation_rate)?;
         check_probability("esp.lesion_threshold", self.lesion_threshold)?;
-        Ok(())
+        let networks = self.networks_per_generation();
+        if networks > MAX_NETWORKS_PER_GENERATION {
+            return Err(format!(
+                "esp.trials_per_neuron x esp.subpop_size = {} x {} = {networks} networks per generation, more than {MAX_NETWORKS_PER_GENERATION}",
+                self.trials_per_neuron, self.subpop_size
+            ));
+        }
+        let (scale_name, scale) = if self.mutation_scale >= self.burst_scale {
+            ("esp.mutation_scale", self.mutation_scale)
+        } else {
+            ("esp.burst_scale", self.burst_scale)
+        };
+        check_cauchy_limit("esp.cauchy_limit", self.cauchy_limit, scale_name, scale)
     }
 
     /// Networks evaluated per generation (lesion tests not counted).

@@ -6,7 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use super::operators::{cauchy, random_genes};
 use super::{
-    best_of, check_count, check_init_range, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
+    best_of, check_cauchy_limit, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
+    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION,
 };
 use super::{Champion, Evaluator, GenerationRecord, RunResult};
 use crate::network::Network;
@@ -64,10 +65,10 @@ impl Default for HillClimbSettings {
 impl HillClimbSettings {
     /// Rejects out-of-range values, naming the setting.
     pub fn validate(&self) -> Result<(), String> {
-        check_count("hill_climb.hidden", self.hidden, 1)?;
-        check_count("hill_climb.candidates", self.candidates, 1)?;
-        check_count("hill_climb.cycles", self.cycles, 1)?;
-        check_init_range("hill_climb.init_range", self.init_range)?;
+        check_count("hill_climb.hidden", self.hidden, 1, MAX_HIDDEN)?;
+        check_count("hill_climb.candidates", self.candidates, 1, MAX_NETWORKS_PER_GENERATION)?;
+        check_count("hill_climb.cycles", self.cycles, 1, MAX_GENERATIONS)?;
+        check_positive("hill_climb.init_range", self.init_range)?;
         check_positive("hill_climb.alpha", self.alpha)?;
         check_positive("hill_climb.cauchy_limit", self.cauchy_limit)?;
         check_probability("hill_climb.p_noise", self.p_noise)?;
@@ -79,7 +80,15 @@ impl HillClimbSettings {
         ] {
             check_positive(name, c)?;
         }
-        Ok(())
+        // alpha is annealed every cycle: the largest scale is the first
+        // cycle's or (annealing upwards) the last's.
+        let last = self.alpha * self.anneal_alpha.powi(self.cycles as i32 - 1);
+        check_cauchy_limit(
+            "hill_climb.cauchy_limit",
+            self.cauchy_limit,
+            "the largest annealed hill_climb.alpha",
+            self.alpha.max(last),
+        )
     }
 }
 

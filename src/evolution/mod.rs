@@ -66,35 +66,70 @@ pub(crate) fn check_probability(name: &str, p: f64) -> Result<(), String> {
     }
 }
 
-/// Checks a positive, finite setting.
+/// The largest initial weight range, Cauchy scale, Cauchy limit or
+/// annealing constant: the paper's are 0.3-10. Weights stay within
+/// [`MAX_REAL_SETTING`] times the generations of a run, so that a network's
+/// sums stay finite.
+pub const MAX_REAL_SETTING: f64 = 1e6;
+
+/// The most generations (ESP) or cycles (hill-climber) of a run (the paper:
+/// 2000); a run keeps one record per generation.
+pub const MAX_GENERATIONS: usize = 1_000_000;
+
+/// The most neurons per sub-population (the paper: 40).
+pub const MAX_SUBPOP_SIZE: usize = 10_000;
+
+/// The most evaluations per neuron and generation (the paper: 10).
+pub const MAX_TRIALS_PER_NEURON: usize = 1_000;
+
+/// The most hidden neurons a run starts with (the paper: 5).
+pub const MAX_HIDDEN: usize = 100;
+
+/// The most networks evaluated per generation (ESP: `trials_per_neuron`
+/// x `subpop_size`; the hill-climber: `candidates`; the paper: 400). A
+/// generation holds them all: at [`MAX_HIDDEN`] neurons of a 7-input,
+/// 4-output network that is about 1 GB.
+pub const MAX_NETWORKS_PER_GENERATION: usize = 100_000;
+
+/// The smallest Cauchy limit, as a multiple of the largest Cauchy scale of
+/// a run. A draw `alpha tan(pi u)` is accepted with probability
+/// `(2 / pi) atan(limit / alpha)`: at least 6.3 % at this ratio, so the
+/// rejection loop ends (the paper's 10 / 0.3 accepts 98 %).
+pub const MIN_CAUCHY_LIMIT_PER_SCALE: f64 = 0.1;
+
+/// Checks a setting in (0, [`MAX_REAL_SETTING`]].
 pub(crate) fn check_positive(name: &str, v: f64) -> Result<(), String> {
-    if v.is_finite() && v > 0.0 {
+    if v > 0.0 && v <= MAX_REAL_SETTING {
         Ok(())
     } else {
-        Err(format!("{name} must be finite and > 0, got {v}"))
+        Err(format!("{name} must be in (0, {MAX_REAL_SETTING:e}], got {v:?}"))
     }
 }
 
-/// Checks the half-width of an initial weight interval (-v, v): positive,
-/// and small enough for the interval's width to be finite.
-pub(crate) fn check_init_range(name: &str, v: f64) -> Result<(), String> {
-    check_positive(name, v)?;
-    if (2.0 * v).is_finite() {
+/// Checks a count setting in [min, max].
+pub(crate) fn check_count(name: &str, n: usize, min: usize, max: usize) -> Result<(), String> {
+    if (min..=max).contains(&n) {
+        Ok(())
+    } else {
+        Err(format!("{name} must be in [{min}, {max}], got {n}"))
+    }
+}
+
+/// Checks that `limit_name` (a Cauchy limit) is at least
+/// [`MIN_CAUCHY_LIMIT_PER_SCALE`] times `largest_scale`, the largest Cauchy
+/// scale the run draws with (described by `scale_name`).
+pub(crate) fn check_cauchy_limit(
+    limit_name: &str,
+    limit: f64,
+    scale_name: &str,
+    largest_scale: f64,
+) -> Result<(), String> {
+    if limit >= MIN_CAUCHY_LIMIT_PER_SCALE * largest_scale {
         Ok(())
     } else {
         Err(format!(
-            "{name} must be at most {:e}, so that (-{name}, {name}) has a finite width, got {v:e}",
-            f64::MAX / 2.0
+            "{limit_name} = {limit:?} must be at least {MIN_CAUCHY_LIMIT_PER_SCALE} x {scale_name} = {largest_scale:e}, so that a Cauchy draw is accepted with probability >= 6 % (the draw is repeated until one is)"
         ))
-    }
-}
-
-/// Checks a count setting.
-pub(crate) fn check_count(name: &str, n: usize, min: usize) -> Result<(), String> {
-    if n >= min {
-        Ok(())
-    } else {
-        Err(format!("{name} must be >= {min}, got {n}"))
     }
 }
 

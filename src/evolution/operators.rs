@@ -5,10 +5,21 @@ use rand::RngExt;
 
 use crate::rng::Stream;
 
+/// The most draws [`cauchy`] makes before it gives up.
+pub const MAX_CAUCHY_DRAWS: u32 = 10_000;
+
 /// A Cauchy draw as in the ESP code: `alpha * tan(pi * u)`, `u` uniform in
 /// (0, 1), drawn again while its magnitude exceeds `limit`.
+///
+/// A draw is accepted with probability `(2 / pi) atan(limit / alpha)`; the
+/// settings' validation keeps it at 6 % or more
+/// ([`MIN_CAUCHY_LIMIT_PER_SCALE`](super::MIN_CAUCHY_LIMIT_PER_SCALE)),
+/// where [`MAX_CAUCHY_DRAWS`] rejections in a row have a probability below
+/// 1e-280. Should they all be rejected all the same (a scale or limit that
+/// was never validated, NaN), the draw is 0: it ends instead of looping
+/// forever.
 pub fn cauchy(rng: &mut Stream, alpha: f64, limit: f64) -> f64 {
-    loop {
+    for _ in 0..MAX_CAUCHY_DRAWS {
         let u: f64 = rng.random();
         if u == 0.0 {
             continue;
@@ -18,6 +29,7 @@ pub fn cauchy(rng: &mut Stream, alpha: f64, limit: f64) -> f64 {
             return value;
         }
     }
+    0.0
 }
 
 /// One-point crossover with the cut at `cut` (0 <= cut < len): the first
@@ -100,6 +112,29 @@ mod tests {
         assert!(abs.iter().filter(|x| **x > 5.0).count() > 100);
         // A tight limit clips everything to it.
         assert!((0..1000).all(|_| cauchy(&mut rng, 1.0, 0.5).abs() <= 0.5));
+    }
+
+    const PINNED_ESP: [u64; 4] = [0; 4];
+    const PINNED_HILL: [u64; 4] = [0; 4];
+
+    #[test]
+    fn cauchy_draws_are_those_of_the_esp_code() {
+        // Pinned: the draws of today's settings (ESP's 0.3 / 10, the
+        // hill-climber's 1 / 10) must never change.
+        let mut rng = stream(7, &[4, 2]);
+        let esp: Vec<u64> = (0..4).map(|_| cauchy(&mut rng, 0.3, 10.0).to_bits()).collect();
+        let hill: Vec<u64> = (0..4).map(|_| cauchy(&mut rng, 1.0, 10.0).to_bits()).collect();
+        assert_eq!(esp, PINNED_ESP, "{esp:#x?}");
+        assert_eq!(hill, PINNED_HILL, "{hill:#x?}");
+    }
+
+    #[test]
+    fn a_cauchy_draw_ends_whatever_its_scale_and_limit() {
+        let mut rng = stream(9, &[]);
+        for (alpha, limit) in [(1e308, 1e-300), (f64::NAN, 10.0), (1.0, f64::NAN), (f64::INFINITY, 1.0)] {
+            let value = cauchy(&mut rng, alpha, limit);
+            assert!(value == 0.0 || value.abs() <= limit, "{alpha} {limit}: {value}");
+        }
     }
 
     #[test]

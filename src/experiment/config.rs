@@ -7,7 +7,7 @@ use std::str::FromStr;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::evolution::{BurstMode, Credit, EspSettings, HillClimbSettings, Sampling, TopologyMode};
+use crate::evolution::{BurstMode, Credit, EspSettings, HillClimbSettings, Sampling, TopologyMode, MAX_GENERATIONS};
 use crate::psa::PsaSettings;
 
 /// Which search algorithm.
@@ -163,8 +163,7 @@ impl RunConfig {
 
     /// [`RunConfig::with_overrides`] with the contents of a file.
     pub fn with_overrides_from(&self, path: &Path) -> Result<RunConfig> {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("cannot read configuration {}", path.display()))?;
+        let text = crate::io::read_input(path, "configuration")?;
         self.with_overrides(&text)
             .with_context(|| format!("configuration {}", path.display()))
     }
@@ -176,8 +175,8 @@ impl RunConfig {
 
     /// Overrides the generations (ESP) or cycles (hill-climber).
     pub fn set_generations(&mut self, generations: usize) -> Result<()> {
-        if generations == 0 {
-            bail!("--generations must be >= 1, got 0");
+        if !(1..=MAX_GENERATIONS).contains(&generations) {
+            bail!("--generations must be in [1, {MAX_GENERATIONS}], got {generations}");
         }
         self.esp.generations = generations;
         self.hill_climb.cycles = generations;

@@ -25,6 +25,9 @@ pub const GRID_FORMAT: &str = "psa-esp-grid";
 /// Its version.
 pub const GRID_VERSION: u32 = 1;
 
+/// The most seeds per configuration and task (the paper: 30).
+pub const MAX_SEEDS: u64 = 10_000;
+
 /// Which protocol a grid follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
@@ -116,13 +119,16 @@ impl GridSpec {
         if self.configs.is_empty() || self.tasks.is_empty() {
             bail!("the grid needs at least one configuration and one task");
         }
-        if self.seeds == 0 || self.generations == 0 || self.robustness_trials == 0 {
-            bail!(
-                "seeds, generations and robustness trials must be >= 1, got {}, {} and {}",
-                self.seeds,
-                self.generations,
-                self.robustness_trials
-            );
+        let max_generations = crate::evolution::MAX_GENERATIONS;
+        let max_trials = crate::psa::limits::MAX_TRIALS;
+        for (name, value, max) in [
+            ("seeds", self.seeds, MAX_SEEDS),
+            ("generations", self.generations as u64, max_generations as u64),
+            ("robustness_trials", self.robustness_trials as u64, max_trials),
+        ] {
+            if !(1..=max).contains(&value) {
+                bail!("{name} must be in [1, {max}], got {value}");
+            }
         }
         if !self.backend.is_available() {
             bail!("backend {} is not available in this build", self.backend);
@@ -158,7 +164,7 @@ impl GridSpec {
     /// Reads `DIR/grid.json`, checking its format and version.
     pub fn load(dir: &Path) -> Result<GridSpec> {
         let path = grid_file(dir);
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let text = crate::io::read_input(&path, "grid file")?;
         let value: serde_json::Value =
             serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
         if value.get("format").and_then(|f| f.as_str()) != Some(GRID_FORMAT) {
@@ -215,8 +221,7 @@ pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus
         // Killed before its first file: nothing of value in it.
         return Ok(RunStatus::Unfinished);
     }
-    let text =
-        std::fs::read_to_string(&config_path).with_context(|| format!("cannot read {}", config_path.display()))?;
+    let text = crate::io::read_input(&config_path, "run configuration")?;
     let expected = spec.run_config(key.config);
     let found = RunConfig::default()
         .with_overrides(&text)
@@ -249,7 +254,7 @@ pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus
 fn check_finished_files(folder: &Path, spec: &GridSpec) -> Result<()> {
     let read = |name: &str| -> Result<String> {
         let path = folder.join(name);
-        std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))
+        crate::io::read_input(&path, "run file")
     };
     let damaged = |name: &str| format!("{}: damaged file", folder.join(name).display());
     serde_json::from_str::<super::robustness::Robustness>(&read(FINISHED_MARKER)?)

@@ -237,7 +237,7 @@ impl GridResults {
 fn load_run(folder: &Path, key: &RunKey) -> Result<RunData> {
     let read = |name: &str| -> Result<(PathBuf, String)> {
         let path = folder.join(name);
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let text = crate::io::read_input(&path, "run file")?;
         Ok((path, text))
     };
     let (path, text) = read("run.json")?;

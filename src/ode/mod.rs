@@ -21,5 +21,5 @@ pub use bare::{BareOdeLoop, BareStepper, RawBodyState};
 pub use error::OdeError;
 pub use mass::Mass;
 pub use messages::{recent_messages, OdeMessage, OdeMessageKind};
-pub use runtime::{ensure_thread_ready, libode_version, thread_pool};
+pub use runtime::{ensure_thread_ready, libode_version, thread_pool, MAX_THREADS};
 pub use world::{Body, Joint, World};

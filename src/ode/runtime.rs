@@ -46,9 +46,22 @@ pub fn ensure_thread_ready() -> Result<(), OdeError> {
     Ok(())
 }
 
+/// The most worker threads a pool may have: far more cores than any one
+/// machine has, and few enough that starting them cannot exhaust the
+/// process' threads or memory (each has its own stack and ODE data).
+pub const MAX_THREADS: usize = 1024;
+
 /// A rayon pool of `threads` workers, each with ODE's per-thread data
-/// allocated as it starts (0 = rayon's default count).
+/// allocated as it starts (0 = rayon's default count, at most
+/// [`MAX_THREADS`]).
 pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, OdeError> {
+    if threads > MAX_THREADS {
+        return Err(OdeError::invalid(
+            "thread count",
+            threads,
+            "at most 1024 (MAX_THREADS) worker threads",
+        ));
+    }
     init_once()?;
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

@@ -138,14 +138,29 @@ pub fn trajectory(
     start: &BodyState,
     commands: &[Vec<f64>],
 ) -> Result<Vec<BodyState>, PhysicsError> {
-    backend.reset(start)?;
     let mut states = Vec::with_capacity(commands.len() + 1);
-    states.push(backend.state());
+    for_each_state(backend, start, commands.iter().map(Vec::as_slice), |s| {
+        states.push(*s);
+        Ok::<_, PhysicsError>(())
+    })?;
+    Ok(states)
+}
+
+/// Runs `commands` from `start`, handing every state, the start included,
+/// to `visit` as it comes (so that a long run needs no memory for them).
+pub fn for_each_state<'a, E: From<PhysicsError>>(
+    backend: &mut dyn PhysicsBackend,
+    start: &BodyState,
+    commands: impl IntoIterator<Item = &'a [f64]>,
+    mut visit: impl FnMut(&BodyState) -> Result<(), E>,
+) -> Result<(), E> {
+    backend.reset(start)?;
+    visit(&backend.state())?;
     for thrust in commands {
         backend.step(thrust)?;
-        states.push(backend.state());
+        visit(&backend.state())?;
     }
-    Ok(states)
+    Ok(())
 }
 
 /// Runs `sequences` random thrust sequences of `steps` steps from rest at

@@ -3,6 +3,7 @@
 //! (rapier2d-f64). Each simulates a [`RigidBodyModel`] in the x-y plane.
 
 mod crosscheck;
+mod guard;
 mod model;
 mod native;
 mod ode_backend;
@@ -16,9 +17,10 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 pub use crosscheck::{
-    crosscheck, random_thrust_sequence, tolerance, trajectory, BackendComparison, CrosscheckReport, Deviation,
-    Tolerance,
+    crosscheck, for_each_state, random_thrust_sequence, tolerance, trajectory, BackendComparison, CrosscheckReport,
+    Deviation, Tolerance,
 };
+pub use guard::{StepGuard, ENGINE_LIMIT};
 pub use model::{MassPart, MassProperties, RigidBodyModel, Thruster};
 pub use native::{NativeBackend, PlanarBody, PlanarState, RotationRule};
 pub use ode_backend::OdeBackend;

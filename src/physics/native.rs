@@ -11,7 +11,8 @@
 //! planar spin about a principal axis, as here.
 
 use super::{
-    validate_thrust, BackendKind, BodyState, MassProperties, PhysicsBackend, PhysicsError, RigidBodyModel, StepSettings,
+    validate_thrust, BackendKind, BodyState, MassProperties, PhysicsBackend, PhysicsError, RigidBodyModel, StepGuard,
+    StepSettings,
 };
 use crate::numeric::{atan2, wrap_angle, Real};
 
@@ -245,6 +246,7 @@ pub struct NativeBackend {
     properties: MassProperties,
     rule: RotationRule,
     state: PlanarState<f64>,
+    guard: StepGuard,
 }
 
 impl NativeBackend {
@@ -264,6 +266,7 @@ impl NativeBackend {
             properties: model.mass_properties(),
             rule,
             state: PlanarState::from_body_state(&BodyState::default()),
+            guard: StepGuard::new(model, settings)?,
         })
     }
 }
@@ -275,7 +278,9 @@ impl PhysicsBackend for NativeBackend {
 
     fn reset(&mut self, state: &BodyState) -> Result<(), PhysicsError> {
         state.validate()?;
-        self.state = PlanarState::from_body_state(state);
+        let state = PlanarState::from_body_state(state);
+        self.guard.check(&state)?;
+        self.state = state;
         Ok(())
     }
 
@@ -285,6 +290,7 @@ impl PhysicsBackend for NativeBackend {
 
     fn step(&mut self, thrust: &[f64]) -> Result<(), PhysicsError> {
         validate_thrust(thrust, self.body.thruster_count())?;
+        self.guard.check(&self.state)?;
         match self.rule {
             RotationRule::OdeQuaternion => self.body.step(&mut self.state, thrust),
             RotationRule::Linearized => self.body.step_linearized(&mut self.state, thrust),

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use super::{
     validate_thrust, BackendKind, BodyState, MassPart, MassProperties, PhysicsBackend, PhysicsError, PlanarState,
-    PlaneConstraint, RigidBodyModel, StepSettings, Stepper,
+    PlaneConstraint, RigidBodyModel, StepGuard, StepSettings, Stepper,
 };
 use crate::ode::{BareOdeLoop, BareStepper, Body, Joint, Mass, World};
 
@@ -26,6 +26,7 @@ pub struct OdeBackend {
     thrusters: Vec<MountedThruster>,
     properties: MassProperties,
     settings: StepSettings,
+    guard: StepGuard,
 }
 
 /// The composite mass of `model` built with ODE's own mass functions, before
@@ -51,6 +52,7 @@ impl OdeBackend {
     pub fn new(model: &RigidBodyModel, settings: &StepSettings) -> Result<Self, PhysicsError> {
         model.validate()?;
         settings.validate()?;
+        let guard = StepGuard::new(model, settings)?;
         let world = World::new()?;
         world.set_gravity([0.0, 0.0, 0.0])?;
         world.set_quick_step_iterations(settings.quick_step_iterations)?;
@@ -98,6 +100,7 @@ impl OdeBackend {
             thrusters,
             properties,
             settings: *settings,
+            guard,
         })
     }
 
@@ -204,6 +207,7 @@ impl PhysicsBackend for OdeBackend {
 
     fn reset(&mut self, state: &BodyState) -> Result<(), PhysicsError> {
         state.validate()?;
+        self.guard.check(&PlanarState::from_body_state(state))?;
         let half = 0.5 * state.heading;
         self.body.set_position([state.x, state.y, 0.0])?;
         self.body.set_quaternion([half.cos(), 0.0, 0.0, half.sin()])?;
@@ -226,13 +230,16 @@ impl PhysicsBackend for OdeBackend {
     }
 
     /// The hot path (issue 6): no allocation, and no check beyond
-    /// `validate_thrust`. Its guarantee (one finite value in [0, 1] per
-    /// thruster) and those of `new` (a validated model, so finite forces at
-    /// full command and finite arms; validated settings, so dt > 0, never
-    /// changed since) are what the prechecked ODE calls require, so the
-    /// wrapper does not check them again.
+    /// `validate_thrust` and the [`StepGuard`]. Their guarantees (one finite
+    /// value in [0, 1] per thruster; a state from which this step stays
+    /// finite, far from overflowing ODE's quaternion update) and those of
+    /// `new` (a validated model, so finite forces at full command and finite
+    /// arms; validated settings, so dt > 0, never changed since) are what the
+    /// prechecked ODE calls require, so the wrapper does not check them
+    /// again.
     fn step(&mut self, thrust: &[f64]) -> Result<(), PhysicsError> {
         validate_thrust(thrust, self.thrusters.len())?;
+        self.guard.check(&self.planar_state())?;
         for (t, &u) in self.thrusters.iter().zip(thrust) {
             let force = [t.force[0] * u, t.force[1] * u, t.force[2] * u];
             self.body.add_rel_force_at_rel_pos_prechecked(force, t.arm);

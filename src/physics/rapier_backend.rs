@@ -29,7 +29,7 @@ use rapier2d_f64::pipeline::PhysicsPipeline;
 
 use super::{
     validate_thrust, BackendKind, BodyState, MassPart, MassProperties, PhysicsBackend, PhysicsError, PlanarState,
-    RigidBodyModel, StepSettings,
+    RigidBodyModel, StepGuard, StepSettings,
 };
 
 /// A thruster's force at full command and its mount relative to the centre
@@ -87,6 +87,7 @@ pub struct RapierBackend {
     model_properties: MassProperties,
     /// The centre of mass in the body's geometric frame, as parry summed it.
     center: [f64; 2],
+    guard: StepGuard,
 }
 
 /// The planar mass properties of `model` built with parry's own functions,
@@ -124,6 +125,7 @@ impl RapierBackend {
     pub fn new(model: &RigidBodyModel, settings: &StepSettings) -> Result<Self, PhysicsError> {
         model.validate()?;
         settings.validate()?;
+        let guard = StepGuard::new(model, settings)?;
         let composite = composite_mass(model);
         let com = composite.local_com;
         // As in the ODE backend, the body origin is the centre of mass: shift
@@ -175,6 +177,7 @@ impl RapierBackend {
             thrusters,
             model_properties: model.mass_properties(),
             center: [com.x, com.y],
+            guard,
         })
     }
 }
@@ -186,6 +189,7 @@ impl PhysicsBackend for RapierBackend {
 
     fn reset(&mut self, state: &BodyState) -> Result<(), PhysicsError> {
         state.validate()?;
+        self.guard.check(&PlanarState::from_body_state(state))?;
         let body = &mut self.world.bodies[self.body];
         body.set_position(Pose::new(Vector::new(state.x, state.y), state.heading), true);
         body.set_linvel(Vector::new(state.vx, state.vy), true);
@@ -210,6 +214,7 @@ impl PhysicsBackend for RapierBackend {
 
     fn step(&mut self, thrust: &[f64]) -> Result<(), PhysicsError> {
         validate_thrust(thrust, self.thrusters.len())?;
+        self.guard.check(&self.planar_state())?;
         let body = &mut self.world.bodies[self.body];
         // User forces persist across steps in rapier: start from zero.
         body.reset_forces(true);

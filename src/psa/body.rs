@@ -47,9 +47,26 @@ impl Default for BodySettings {
 }
 
 impl BodySettings {
-    /// The rigid-body model every backend simulates. Fails on a
-    /// non-positive or non-finite size, density or force.
+    /// Rejects values outside their [ranges](super::limits).
+    pub fn validate(&self) -> Result<(), PhysicsError> {
+        let [length, width, height] = self.thruster_size;
+        super::limits::check_all(&[
+            ("body.hull_radius", self.hull_radius),
+            ("body.hull_height", self.hull_height),
+            ("body.thruster_size", length),
+            ("body.thruster_size", width),
+            ("body.thruster_size", height),
+            ("body.mount_radius", self.mount_radius),
+            ("body.density", self.density),
+            ("body.max_force", self.max_force),
+        ])
+        .map_err(PhysicsError::InvalidModel)
+    }
+
+    /// The rigid-body model every backend simulates. Fails on a value
+    /// outside its range ([`BodySettings::validate`]).
     pub fn model(&self) -> Result<RigidBodyModel, PhysicsError> {
+        self.validate()?;
         let r = self.mount_radius;
         let [length, width, height] = self.thruster_size;
         // (mount, thrust direction); boxes lie with their length along the thrust.

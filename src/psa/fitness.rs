@@ -63,20 +63,15 @@ pub struct StepError<R = f64> {
 }
 
 impl FitnessSettings {
-    /// Rejects non-finite or negative values.
+    /// Rejects values outside their [ranges](super::limits).
     pub fn validate(&self) -> Result<(), String> {
-        for (name, v) in [
-            ("box_half_width", self.box_half_width),
-            ("heading_window", self.heading_window),
-            ("spin_window", self.spin_window),
-            ("position_points", self.position_points),
-            ("heading_points", self.heading_points),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("fitness.{name} must be finite and >= 0, got {v}"));
-            }
-        }
-        Ok(())
+        super::limits::check_all(&[
+            ("fitness.box_half_width", self.box_half_width),
+            ("fitness.heading_window", self.heading_window),
+            ("fitness.spin_window", self.spin_window),
+            ("fitness.position_points", self.position_points),
+            ("fitness.heading_points", self.heading_points),
+        ])
     }
 
     /// The points one step earns.

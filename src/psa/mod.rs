@@ -5,6 +5,7 @@
 pub mod batch;
 pub mod body;
 pub mod fitness;
+pub mod limits;
 pub mod network_file;
 pub mod sensors;
 pub mod task;

@@ -75,19 +75,15 @@ impl SensorSettings {
         ]
     }
 
-    /// Rejects non-finite values.
+    /// Rejects values outside their [ranges](super::limits).
     pub fn validate(&self) -> Result<(), String> {
-        let v = [
-            ("position_scale", self.position_scale),
-            ("velocity_scale", self.velocity_scale),
-            ("heading_scale", self.heading_scale),
-            ("angular_velocity_scale", self.angular_velocity_scale),
-            ("bias", self.bias),
-        ];
-        match v.iter().find(|(_, x)| !x.is_finite()) {
-            Some((name, x)) => Err(format!("sensors.{name} must be finite, got {x}")),
-            None => Ok(()),
-        }
+        super::limits::check_all(&[
+            ("sensors.position_scale", self.position_scale),
+            ("sensors.velocity_scale", self.velocity_scale),
+            ("sensors.heading_scale", self.heading_scale),
+            ("sensors.angular_velocity_scale", self.angular_velocity_scale),
+            ("sensors.bias", self.bias),
+        ])
     }
 }
 
@@ -103,14 +99,9 @@ pub struct NoiseSettings {
 }
 
 impl NoiseSettings {
-    /// Rejects negative or non-finite deviations.
+    /// Rejects deviations outside their [ranges](super::limits).
     pub fn validate(&self) -> Result<(), String> {
-        for (name, sd) in [("input_sd", self.input_sd), ("output_sd", self.output_sd)] {
-            if !(sd.is_finite() && sd >= 0.0) {
-                return Err(format!("noise.{name} must be finite and >= 0, got {sd}"));
-            }
-        }
-        Ok(())
+        super::limits::check_all(&[("noise.input_sd", self.input_sd), ("noise.output_sd", self.output_sd)])
     }
 
     /// Whether any noise is configured.

@@ -114,22 +114,22 @@ impl Default for TaskSettings {
 }
 
 impl TaskSettings {
-    /// Rejects non-finite values and an empty distance range.
+    /// Rejects values outside their [ranges](super::limits) and an empty
+    /// distance range.
     pub fn validate(&self) -> Result<(), String> {
-        let values = [
-            ("task1_spin", self.task1_spin),
-            ("task2_target_heading", self.task2_target_heading),
-            ("task3_speed", self.task3_speed),
-            ("task3_distance", self.task3_distance),
-            ("task3_target_heading", self.task3_target_heading),
-        ];
-        if let Some((name, v)) = values.iter().find(|(_, v)| !v.is_finite()) {
-            return Err(format!("tasks.{name} must be finite, got {v}"));
-        }
         let [lo, hi] = self.task3_random_distance;
-        if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+        super::limits::check_all(&[
+            ("tasks.task1_spin", self.task1_spin),
+            ("tasks.task2_target_heading", self.task2_target_heading),
+            ("tasks.task3_speed", self.task3_speed),
+            ("tasks.task3_distance", self.task3_distance),
+            ("tasks.task3_target_heading", self.task3_target_heading),
+            ("tasks.task3_random_distance", lo),
+            ("tasks.task3_random_distance", hi),
+        ])?;
+        if lo > hi {
             return Err(format!(
-                "tasks.task3_random_distance must be a finite range [low, high], got [{lo}, {hi}]"
+                "tasks.task3_random_distance must be a range [low, high], got [{lo}, {hi}]"
             ));
         }
         Ok(())

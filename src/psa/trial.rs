@@ -73,14 +73,23 @@ impl Default for PsaSettings {
 }
 
 impl PsaSettings {
-    /// Rejects impossible values, naming the setting.
+    /// Rejects values outside their [ranges](super::limits) and impossible
+    /// combinations, naming the setting.
     pub fn validate(&self) -> Result<(), PsaError> {
-        if self.steps == 0 {
-            return Err(PsaError::Setting("steps must be >= 1, got 0".into()));
-        }
-        if self.trials == 0 {
-            return Err(PsaError::Setting("trials must be >= 1, got 0".into()));
-        }
+        super::limits::check_all(&[
+            ("steps", self.steps as f64),
+            ("trials", self.trials as f64),
+            ("physics.dt", self.physics.dt),
+            (
+                "physics.quick_step_iterations",
+                self.physics.quick_step_iterations.into(),
+            ),
+            (
+                "physics.rapier_solver_iterations",
+                self.physics.rapier_solver_iterations.into(),
+            ),
+        ])
+        .map_err(PsaError::Setting)?;
         self.sensors.validate().map_err(PsaError::Setting)?;
         self.noise.validate().map_err(PsaError::Setting)?;
         self.tasks.validate().map_err(PsaError::Setting)?;
