@@ -1,17 +1,21 @@
-//! Search algorithms over networks: Enforced Sub-Populations (ESP) with every
-//! modification of Høverstad (2007) as a switch, and his hill-climber.
+//! Enforced Sub-Populations (ESP), the neuroevolution method of Gomez &
+//! Miikkulainen, with every modification of Høverstad, "Revisiting the
+//! Personal Satellite Assistant" (GECCO 2007), as a switch; and his
+//! parallel stochastic hill-climber.
 //!
-//! Both are generic: they search [`Network`](crate::network::Network)s against any [`Evaluator`] and
-//! know nothing of the PSA. Network evaluations run in parallel on rayon;
-//! every random draw comes from a stream keyed by what it is for (seed,
-//! generation, network, ...), so a run is bit-identical for any thread count.
+//! Both search [`Network`](network::Network)s (one hidden layer of
+//! logistic units, stored neuron by neuron as ESP needs it) against any
+//! [`Evaluator`]: a function that scores a network on your problem. Network
+//! evaluations run in parallel on rayon; every random draw comes from a
+//! counter-based stream ([`rng`]) keyed by what it is for (seed, generation,
+//! network, ...), so a run is bit-identical for any thread count.
 //!
 //! ```
-//! use psa_esp::evolution::{Esp, EspSettings, FnEvaluator};
-//! use psa_esp::network::Network;
+//! use esp_neuroevolution::network::Network;
+//! use esp_neuroevolution::{Esp, EspSettings, FnEvaluator};
 //!
 //! // Any control problem: here, make output 0 follow input 0 (a 2-H-1 network, bias last).
-//! let evaluator = FnEvaluator::new(2, 1, |net: &Network, _rng: &mut psa_esp::rng::Stream| {
+//! let evaluator = FnEvaluator::new(2, 1, |net: &Network, _rng: &mut esp_neuroevolution::rng::Stream| {
 //!     let mut out = [0.0];
 //!     let mut error = 0.0;
 //!     for x in [0.0, 0.25, 0.5, 0.75, 1.0] {
@@ -28,8 +32,11 @@
 mod esp;
 mod evaluator;
 mod hill_climb;
+pub mod math;
+pub mod network;
 pub mod operators;
 mod record;
+pub mod rng;
 mod subpop;
 
 pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, TopologyMode};

@@ -215,7 +215,7 @@ impl HillClimb {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evolution::FnEvaluator;
+    use crate::FnEvaluator;
 
     #[test]
     fn noise_and_sign_flips_happen_at_the_configured_rates() {

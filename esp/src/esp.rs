@@ -601,7 +601,7 @@ impl Esp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evolution::FnEvaluator;
+    use crate::FnEvaluator;
 
     fn esp(settings: EspSettings) -> Esp {
         Esp::new(settings, 11).unwrap()

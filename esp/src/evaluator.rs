@@ -11,9 +11,10 @@ use rayon::prelude::*;
 use crate::network::{Network, NetworkSet};
 use crate::rng::{Stream, StreamFamily};
 
-/// Scores networks. `Worker` is per-thread state (for the PSA: a physics
-/// world, which must stay on the thread that made it); the algorithms make
-/// one per parallel task and never move it between threads.
+/// Scores networks. `Worker` is per-thread state (for a physics
+/// simulation, its world, which may have to stay on the thread that made
+/// it); the algorithms make one per parallel task and never move it
+/// between threads.
 pub trait Evaluator: Sync {
     /// Per-thread evaluation state.
     type Worker;
