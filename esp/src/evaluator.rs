@@ -6,6 +6,8 @@ use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
+
+use crate::RunError;
 use rayon::prelude::*;
 
 use crate::network::{Network, NetworkSet};
@@ -128,7 +130,7 @@ pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
     networks: &S,
     seed: u64,
     key: &[u64],
-) -> Result<Vec<f64>> {
+) -> Result<Vec<f64>, RunError> {
     let streams = StreamFamily::new(seed, key);
     if evaluator.batch_size() > 1 {
         return evaluate_batches(evaluator, networks, &streams);
@@ -138,9 +140,7 @@ pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
         .map_init(
             || evaluator.worker().map_err(|e| format!("{e:#}")),
             |worker, j| {
-                let worker = worker
-                    .as_mut()
-                    .map_err(|e| anyhow!("cannot set up an evaluation worker: {e}"))?;
+                let worker = worker.as_mut().map_err(|e| RunError::Worker(anyhow!("{e}")))?;
                 let fitness = evaluator.evaluate(worker, &networks.network(j), &mut streams.stream(j))?;
                 check_fitness(&[fitness], j)?;
                 Ok(fitness)
@@ -151,9 +151,9 @@ pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
 
 /// An error naming the first network whose fitness is NaN; `first` is the
 /// index of `fitness[0]`.
-fn check_fitness(fitness: &[f64], first: usize) -> Result<()> {
+fn check_fitness(fitness: &[f64], first: usize) -> Result<(), RunError> {
     match fitness.iter().position(|f| f.is_nan()) {
-        Some(i) => Err(anyhow!("the evaluation returned NaN for network {}", first + i)),
+        Some(i) => Err(RunError::NanFitness { network: first + i }),
         None => Ok(()),
     }
 }
@@ -280,7 +280,7 @@ struct Batches<'a, S: ?Sized> {
     /// Networks evaluated (or abandoned by a panic).
     done: AtomicUsize,
     /// Each batch's first network and result.
-    results: Mutex<Vec<(usize, Result<Vec<f64>>)>>,
+    results: Mutex<Vec<(usize, Result<Vec<f64>, RunError>)>>,
 }
 
 /// Counts a batch's networks as done when dropped, so that a panicking
@@ -324,14 +324,10 @@ impl<S: NetworkSet + ?Sized> Batches<'_, S> {
         worker: &mut Option<E::Worker>,
         range: Range<usize>,
         streams: &StreamFamily,
-    ) -> Result<Vec<f64>> {
+    ) -> Result<Vec<f64>, RunError> {
         let worker = match worker {
             Some(worker) => worker,
-            None => worker.insert(
-                evaluator
-                    .worker()
-                    .map_err(|e| anyhow!("cannot set up an evaluation worker: {e:#}"))?,
-            ),
+            None => worker.insert(evaluator.worker().map_err(RunError::Worker)?),
         };
         let start = range.start;
         let fitness = evaluator.evaluate_batch(worker, self.networks, range, streams)?;
@@ -364,7 +360,7 @@ fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
     evaluator: &E,
     networks: &S,
     streams: &StreamFamily,
-) -> Result<Vec<f64>> {
+) -> Result<Vec<f64>, RunError> {
     BATCH_CALLS.fetch_add(1, Ordering::AcqRel);
     let threads = rayon::current_num_threads();
     let batches = Batches {

@@ -29,6 +29,7 @@
 //! assert!(result.champion.fitness > -0.05);
 //! ```
 
+mod error;
 mod esp;
 mod evaluator;
 mod hill_climb;
@@ -39,10 +40,15 @@ mod record;
 pub mod rng;
 mod subpop;
 
+pub use error::{RunError, SettingsError};
 pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, TopologyMode};
 pub use evaluator::{evaluate_all, evaluate_each, Evaluator, FnEvaluator};
 pub use hill_climb::{HillClimb, HillClimbSettings, MutationRates};
-pub use record::{Champion, GenerationRecord, LesionOutcome, RunResult};
+pub use record::{Champion, Control, Ending, GenerationRecord, LesionOutcome, RunResult, StopAt};
+
+/// Records reserved at a run's start: at most its generations, which may
+/// be many more than a run that stops early needs.
+pub(crate) const RECORDS_RESERVED: usize = 4096;
 
 /// Keys of the random streams, one per purpose.
 pub(crate) mod purpose {
@@ -65,43 +71,44 @@ pub(crate) mod purpose {
 }
 
 /// Checks a probability setting.
-pub(crate) fn check_probability(name: &str, p: f64) -> Result<(), String> {
-    if (0.0..=1.0).contains(&p) {
+pub(crate) fn check_probability(name: &'static str, value: f64) -> Result<(), SettingsError> {
+    if (0.0..=1.0).contains(&value) {
         Ok(())
     } else {
-        Err(format!("{name} must be a probability in [0, 1], got {p}"))
+        Err(SettingsError::NotAProbability { name, value })
     }
 }
 
 /// Checks a positive, finite setting.
-pub(crate) fn check_positive(name: &str, v: f64) -> Result<(), String> {
-    if v.is_finite() && v > 0.0 {
+pub(crate) fn check_positive(name: &'static str, value: f64) -> Result<(), SettingsError> {
+    if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(format!("{name} must be finite and > 0, got {v}"))
+        Err(SettingsError::NotPositive { name, value })
     }
 }
 
 /// Checks the half-width of an initial weight interval (-v, v): positive,
 /// and small enough for the interval's width to be finite.
-pub(crate) fn check_init_range(name: &str, v: f64) -> Result<(), String> {
-    check_positive(name, v)?;
-    if (2.0 * v).is_finite() {
+pub(crate) fn check_init_range(name: &'static str, value: f64) -> Result<(), SettingsError> {
+    check_positive(name, value)?;
+    if (2.0 * value).is_finite() {
         Ok(())
     } else {
-        Err(format!(
-            "{name} must be at most {:e}, so that (-{name}, {name}) has a finite width, got {v:e}",
-            f64::MAX / 2.0
-        ))
+        Err(SettingsError::RangeTooWide {
+            name,
+            value,
+            max: f64::MAX / 2.0,
+        })
     }
 }
 
 /// Checks a count setting.
-pub(crate) fn check_count(name: &str, n: usize, min: usize) -> Result<(), String> {
-    if n >= min {
+pub(crate) fn check_count(name: &'static str, value: usize, min: usize) -> Result<(), SettingsError> {
+    if value >= min {
         Ok(())
     } else {
-        Err(format!("{name} must be >= {min}, got {n}"))
+        Err(SettingsError::TooFew { name, value, min })
     }
 }
 

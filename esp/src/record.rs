@@ -55,6 +55,10 @@ pub struct Champion {
     pub fitness: f64,
     /// The generation (cycle) it was found in, from 1.
     pub generation: usize,
+    /// The evaluation that found it, counting every network the run
+    /// evaluated (lesion tests included) from 1: a run stopped at a goal
+    /// fitness took this many evaluations to reach it.
+    pub evaluation: u64,
 }
 
 /// The outcome of a run.
@@ -64,4 +68,78 @@ pub struct RunResult {
     pub champion: Champion,
     /// One record per generation (cycle).
     pub records: Vec<GenerationRecord>,
+    /// Why the run ended.
+    pub ending: Ending,
+}
+
+impl RunResult {
+    /// Network evaluations the run spent, lesion tests included.
+    pub fn evaluations(&self) -> u64 {
+        self.records.last().map_or(0, |r| r.evaluations)
+    }
+}
+
+/// What a run does after a generation (cycle): the per-generation callback
+/// returns it, or returns `()`, which means [`Control::Continue`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Control {
+    /// Go on to the next generation.
+    #[default]
+    Continue,
+    /// End the run now and return its result.
+    Stop,
+}
+
+impl From<()> for Control {
+    fn from((): ()) -> Control {
+        Control::Continue
+    }
+}
+
+/// Why a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ending {
+    /// It ran all its generations (cycles).
+    Completed,
+    /// The champion reached [`StopAt::goal`].
+    Goal,
+    /// The run spent [`StopAt::evaluations`].
+    Budget,
+    /// The per-generation callback returned [`Control::Stop`].
+    Stopped,
+}
+
+/// When a run ends before its last generation, decided after every
+/// generation (cycle). A generation is never cut short: a run that reaches
+/// its budget in the middle of a generation finishes it (and its lesion
+/// test), and its result says exactly how many evaluations it spent.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StopAt {
+    /// End once the champion's fitness is at least this.
+    pub goal: Option<f64>,
+    /// End once at least this many networks have been evaluated.
+    pub evaluations: Option<u64>,
+}
+
+impl StopAt {
+    /// Never before the last generation.
+    pub const NEVER: StopAt = StopAt {
+        goal: None,
+        evaluations: None,
+    };
+
+    /// The decision after the generation that `record` describes, given
+    /// the callback's: why the run ends there, if it does.
+    pub fn decide(&self, record: &GenerationRecord, callback: Control) -> Option<Ending> {
+        if self.goal.is_some_and(|goal| record.champion >= goal) {
+            Some(Ending::Goal)
+        } else if self.evaluations.is_some_and(|budget| record.evaluations >= budget) {
+            Some(Ending::Budget)
+        } else if callback == Control::Stop {
+            Some(Ending::Stopped)
+        } else {
+            None
+        }
+    }
 }

@@ -41,6 +41,20 @@ impl Default for RunConfig {
     }
 }
 
+/// ESP's settings for the PSA, the paper's baseline (its Table 1):
+/// Høverstad's ESP with 5 sub-populations of 40 neurons at first, 10
+/// networks per neuron (400 a generation) and 2000 generations.
+pub fn paper_esp_settings() -> EspSettings {
+    EspSettings {
+        subpop_size: 40,
+        trials_per_neuron: 10,
+        initial_hidden: 5,
+        generations: 2000,
+        init_range: 6.0,
+        ..EspSettings::hoverstad()
+    }
+}
+
 /// One configuration of the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
@@ -88,10 +102,9 @@ impl Preset {
 
     /// The configuration: the baseline with this preset's one change.
     pub fn config(self) -> RunConfig {
-        let esp = EspSettings::default();
         let mut config = RunConfig {
             algorithm: Algorithm::Esp,
-            esp: esp.clone(),
+            esp: paper_esp_settings(),
             hill_climb: HillClimbSettings::default(),
             problem: PsaSettings::default(),
         };
