@@ -28,7 +28,7 @@ pub const EXIT_ERROR: i32 = 2;
 
 /// Evolving neural controllers for the Personal Satellite Assistant.
 #[derive(Debug, Parser)]
-#[command(name = "psa-esp", version, about, long_about = None)]
+#[command(name = "psa-esp", version = crate::provenance::VERSION, about, long_about = None)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
