@@ -32,7 +32,7 @@ pub mod operators;
 mod record;
 mod subpop;
 
-pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, TopologyMode};
+pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, StagnationRule, TopologyMode};
 pub use evaluator::{evaluate_all, evaluate_each, Evaluator, FnEvaluator};
 pub use hill_climb::{HillClimb, HillClimbSettings, MutationRates};
 pub use record::{Champion, GenerationRecord, LesionOutcome, RunResult};
