@@ -180,13 +180,13 @@ fn spin_damper() -> psa_esp::network::Network {
 
 #[test]
 fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
-    use psa_esp::psa::{NetworkFile, SensorSettings, Task};
+    use psa_esp::psa::{NetworkFile, PsaSettings, Task};
     let dir = tempfile::tempdir().unwrap();
     let net_path = dir.path().join("damper.json");
     NetworkFile::new(
         &spin_damper(),
         Task::StopRotation,
-        SensorSettings::default(),
+        &PsaSettings::default(),
         serde_json::Map::new(),
     )
     .save(&net_path)

@@ -54,6 +54,23 @@ pub enum BurstMode {
     Gomez,
 }
 
+/// When the search has stagnated (`algorithms.md` §1; the paper's §3.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StagnationRule {
+    /// The paper's and Gomez's code's reading: the best network fitness of
+    /// each generation is logged since the last burst mutation (the phase
+    /// best, reset at every burst and topology change); stagnation is
+    /// declared when it has not risen for `stagnation` generations. After a
+    /// burst the population climbs back, and each rise postpones the next
+    /// burst. `[paper]`
+    PhaseBest,
+    /// Generations since the search's best network (all-time) last
+    /// improved: after a fruitless burst the next one follows exactly
+    /// `stagnation` generations later. (This tool's first reading.)
+    AllTimeBest,
+}
+
 /// Whether lesion tests change the topology.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -91,8 +108,12 @@ pub struct EspSettings {
     pub mutation_scale: f64,
     /// Cauchy draws larger than this in magnitude are drawn again. `[paper]` 10
     pub cauchy_limit: f64,
-    /// Generations without improvement of the best network before a burst mutation (b). `[paper]` 20
+    /// Generations without improvement before a burst mutation (b).
+    /// Gomez's code: 20 (the default); Høverstad gives no number (the PSA's
+    /// fitted value is 40: psa-esp's docs/model.md)
     pub stagnation: usize,
+    /// What "without improvement" means. Gomez's code and Høverstad's §3.2: phase_best
+    pub stagnation_rule: StagnationRule,
     /// Scale of the Cauchy noise of burst mutation, on every gene. `[paper]` 0.3
     pub burst_scale: f64,
     /// Burst mutation's form. `[paper, Høverstad]` discard_all
@@ -148,6 +169,7 @@ impl EspSettings {
             mutation_scale: 0.3,
             cauchy_limit: 10.0,
             stagnation: 20,
+            stagnation_rule: StagnationRule::PhaseBest,
             burst_scale: 0.3,
             burst: BurstMode::DiscardAll,
             topology: TopologyMode::Lesion,
@@ -197,7 +219,11 @@ struct State {
     /// The search's best network and its fitness (what burst mutation builds on).
     best: Option<(Network, f64)>,
     champion: Option<Champion>,
+    /// Generations without improvement, as the stagnation rule counts them.
     since_improvement: usize,
+    /// The best network fitness since the phase began (the last burst
+    /// mutation or topology change; the run's start).
+    phase_best: f64,
     bursts_since_improvement: usize,
     /// Discard-all: the topology change to apply again after each burst.
     pending: Option<LesionOutcome>,
@@ -215,6 +241,7 @@ impl State {
             best: None,
             champion: None,
             since_improvement: 0,
+            phase_best: f64::NEG_INFINITY,
             bursts_since_improvement: 0,
             pending: None,
             bursts: 0,
@@ -437,9 +464,16 @@ impl Esp {
         let improved = state.best.as_ref().is_none_or(|(_, f)| top_fitness > *f);
         if improved {
             state.best = Some((top, top_fitness));
-            state.since_improvement = 0;
             state.bursts_since_improvement = 0;
             state.pending = None;
+        }
+        let progressed = match s.stagnation_rule {
+            StagnationRule::AllTimeBest => improved,
+            StagnationRule::PhaseBest => top_fitness > state.phase_best,
+        };
+        state.phase_best = state.phase_best.max(top_fitness);
+        if progressed {
+            state.since_improvement = 0;
         } else {
             state.since_improvement += 1;
         }
@@ -448,6 +482,7 @@ impl Esp {
         let mut lesion = None;
         if state.since_improvement >= s.stagnation {
             state.since_improvement = 0;
+            state.phase_best = f64::NEG_INFINITY;
             burst = true;
             lesion = self.stagnate(evaluator, state, generation)?;
         } else {
@@ -1073,5 +1108,50 @@ mod tests {
             err.to_string(),
             "esp.mutation_rate must be a probability in [0, 1], got 1.5"
         );
+    }
+
+    /// Feeds `tops` to `conclude` as the generations' best fitnesses (no
+    /// lesion tests) and returns the generations that burst.
+    fn bursts_for(rule: StagnationRule, tops: &[f64]) -> Vec<usize> {
+        let e = esp(EspSettings {
+            subpop_size: 8,
+            trials_per_neuron: 2,
+            stagnation: 3,
+            stagnation_rule: rule,
+            topology: TopologyMode::Off,
+            ..EspSettings::default()
+        });
+        let mut st = state(&e, 2);
+        let eval = all_neurons_needed();
+        let mut bursts = Vec::new();
+        for (g, &top) in tops.iter().enumerate() {
+            let generation = g + 1;
+            let picks = e.sample(generation, st.subpops.len());
+            let network = st.networks(&picks).unwrap().network(0).into_owned();
+            let fitness = vec![top; picks.count()];
+            let record = e
+                .conclude(&eval, &mut st, &picks, fitness, (network, top, 1), generation)
+                .unwrap();
+            if record.burst {
+                bursts.push(generation);
+            }
+        }
+        bursts
+    }
+
+    #[test]
+    fn stagnation_follows_the_phase_best_or_the_all_time_best() {
+        // The best of generation 1 stands; the burst at 4 sets the
+        // population back, which climbs again during 5-7 without reaching 5.
+        let tops = [5.0, 5.0, 5.0, 5.0, 1.0, 2.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0];
+        // Phase best: each rise postpones the burst; stagnation is 3
+        // generations after the phase best last rose.
+        assert_eq!(bursts_for(StagnationRule::PhaseBest, &tops), [4, 10]);
+        // All-time best: a fruitless burst is followed by the next exactly 3 later.
+        assert_eq!(bursts_for(StagnationRule::AllTimeBest, &tops), [4, 7, 10, 13]);
+        // A new all-time best restarts both counts.
+        let rising = [1.0, 2.0, 3.0, 3.0, 3.0, 3.0, 4.0, 4.0, 4.0, 4.0];
+        assert_eq!(bursts_for(StagnationRule::PhaseBest, &rising), [6, 10]);
+        assert_eq!(bursts_for(StagnationRule::AllTimeBest, &rising), [6, 10]);
     }
 }

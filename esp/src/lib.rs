@@ -41,7 +41,7 @@ pub mod rng;
 mod subpop;
 
 pub use error::{RunError, SettingsError};
-pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, TopologyMode};
+pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, StagnationRule, TopologyMode};
 pub use evaluator::{evaluate_all, evaluate_each, Evaluator, FnEvaluator};
 pub use hill_climb::{HillClimb, HillClimbSettings, MutationRates};
 pub use record::{Champion, Control, Ending, GenerationRecord, LesionOutcome, RunResult, StopAt};

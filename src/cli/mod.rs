@@ -16,6 +16,7 @@ mod replay;
 mod replicate;
 mod report;
 mod simulate;
+mod sweep;
 
 use std::fmt::Write as _;
 
@@ -46,6 +47,8 @@ pub enum Command {
     Evolve(evolve::EvolveArgs),
     /// Run the paper's experiment grid (resumable).
     Replicate(replicate::ReplicateArgs),
+    /// Run the grid once for each value (or combination of values) of any settings (resumable).
+    Sweep(sweep::SweepArgs),
     /// Compare a grid's results with the paper's tables: report.md, figures, and CSV or JSON.
     Report(report::ReportArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
@@ -61,6 +64,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
         Command::Crosscheck(args) => crosscheck::run(args),
         Command::Evolve(args) => evolve::run(args),
         Command::Replicate(args) => replicate::run(args),
+        Command::Sweep(args) => sweep::run(args),
         Command::Report(args) => report::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),

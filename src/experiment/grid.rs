@@ -57,6 +57,10 @@ pub struct GridSpec {
     pub backend: BackendKind,
     /// Trials of each robustness test.
     pub robustness_trials: usize,
+    /// Settings laid over every configuration of the grid before its own
+    /// change (a TOML document, as `--config` files are written).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overrides: Option<String>,
 }
 
 /// The folder status of one run.
@@ -98,6 +102,7 @@ impl GridSpec {
             generations,
             backend,
             robustness_trials,
+            overrides: None,
         }
     }
 
@@ -127,6 +132,9 @@ impl GridSpec {
         if !self.backend.is_available() {
             bail!("backend {} is not available in this build", self.backend);
         }
+        for &config in &self.configs {
+            self.run_config(config)?;
+        }
         Ok(())
     }
 
@@ -147,42 +155,31 @@ impl GridSpec {
     }
 
     /// The full configuration a run of `config` uses in this grid.
-    pub fn run_config(&self, config: GridConfig) -> RunConfig {
-        let mut c = config.config();
+    pub fn run_config(&self, config: GridConfig) -> Result<RunConfig> {
+        let base = match &self.overrides {
+            Some(text) => RunConfig::baseline_with(text).context("the grid's configuration overrides")?,
+            None => RunConfig::default(),
+        };
+        let mut c = config.apply(base);
         c.esp.generations = self.generations;
         c.hill_climb.cycles = self.generations;
         c.problem.backend = self.backend;
-        c
+        c.validate()
+            .with_context(|| format!("configuration {config} with the grid's overrides"))?;
+        Ok(c)
     }
 
     /// Reads `DIR/grid.json`, checking its format and version.
     pub fn load(dir: &Path) -> Result<GridSpec> {
         let path = grid_file(dir);
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
-        let value: serde_json::Value =
-            serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
-        if value.get("format").and_then(|f| f.as_str()) != Some(GRID_FORMAT) {
-            bail!(
-                "{}: not a psa-esp grid file (no \"format\": {GRID_FORMAT:?})",
-                path.display()
-            );
-        }
-        if value.get("version").and_then(|v| v.as_u64()) != Some(GRID_VERSION as u64) {
-            bail!(
-                "{}: unknown grid version; this build reads version {GRID_VERSION}",
-                path.display()
-            );
-        }
-        let spec: GridSpec = serde_json::from_value(value).with_context(|| format!("{}", path.display()))?;
+        let spec: GridSpec = crate::io::read_versioned_json(&path, GRID_FORMAT, GRID_VERSION, "grid")?;
         spec.validate().with_context(|| format!("{}", path.display()))?;
         Ok(spec)
     }
 
     /// Writes `DIR/grid.json` atomically.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        let mut json = serde_json::to_string_pretty(self)?;
-        json.push('\n');
-        crate::io::write_atomic(&grid_file(dir), json.as_bytes())
+        crate::io::write_json(&grid_file(dir), self)
     }
 }
 
@@ -217,7 +214,7 @@ pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus
     }
     let text =
         std::fs::read_to_string(&config_path).with_context(|| format!("cannot read {}", config_path.display()))?;
-    let expected = spec.run_config(key.config);
+    let expected = spec.run_config(key.config)?;
     let found = RunConfig::default()
         .with_overrides(&text)
         .with_context(|| format!("{}: damaged configuration", config_path.display()))?;

@@ -9,6 +9,7 @@ pub mod report;
 pub mod robustness;
 mod run;
 pub mod stats;
+pub mod sweep;
 
 pub use config::{paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};
 pub use evaluator::{PsaEvaluator, PsaWorker, SIMD_VARIABLE};

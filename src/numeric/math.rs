@@ -149,6 +149,7 @@ pub fn clamp_unit<R: Real>(u: R) -> R {
 mod tests {
     use super::super::Lanes;
     use super::*;
+    use esp_neuroevolution::math::Float;
 
     fn ulps(a: f64, b: f64) -> u64 {
         (a.to_bits() as i64).abs_diff(b.to_bits() as i64)
