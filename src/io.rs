@@ -105,6 +105,40 @@ pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Resu
     result.with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// Writes `value` to `path` atomically as pretty JSON with a final newline.
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    let mut json = serde_json::to_string_pretty(value)?;
+    json.push('\n');
+    write_atomic(path, json.as_bytes())
+}
+
+/// Reads the JSON document at `path` whose `"format"` field must be
+/// `format` and `"version"` field `version` (the error names the file and
+/// calls it `what`, e.g. "grid").
+pub fn read_versioned_json<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    format: &str,
+    version: u32,
+    what: &str,
+) -> Result<T> {
+    let text = read_input(path, &format!("{what} file"))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
+    if value.get("format").and_then(|f| f.as_str()) != Some(format) {
+        anyhow::bail!(
+            "{}: not a psa-esp {what} file (no \"format\": {format:?})",
+            path.display()
+        );
+    }
+    if value.get("version").and_then(|v| v.as_u64()) != Some(version as u64) {
+        anyhow::bail!(
+            "{}: unknown {what} version; this build reads version {version}",
+            path.display()
+        );
+    }
+    serde_json::from_value(value).with_context(|| format!("{}", path.display()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

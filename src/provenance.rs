@@ -14,6 +14,17 @@ pub struct BuildInfo {
     pub libode_version: &'static str,
 }
 
+/// What `psa-esp --version` prints after the name: the crate version, the
+/// commit and the libode version.
+pub const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (commit ",
+    env!("PSA_ESP_GIT_COMMIT"),
+    ", libode ",
+    env!("PSA_ESP_LIBODE_VERSION"),
+    ")"
+);
+
 /// This binary's build identity.
 pub fn build_info() -> BuildInfo {
     BuildInfo {

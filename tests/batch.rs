@@ -217,7 +217,7 @@ fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
             subpop_size: 12,
             generations: 12,
             stagnation: 3,
-            ..EspSettings::default()
+            ..psa_esp::experiment::paper_esp_settings()
         },
         7,
     )

@@ -18,6 +18,21 @@ fn stderr(o: &Output) -> String {
 }
 
 #[test]
+fn version_names_the_commit_and_the_libode_version() {
+    let o = psa_esp(&["--version"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info = psa_esp::provenance::build_info();
+    assert_eq!(
+        stdout(&o).trim(),
+        format!(
+            "psa-esp {} (commit {}, libode {})",
+            info.tool_version, info.git_commit, info.libode_version
+        )
+    );
+    assert!(info.libode_version.starts_with("0."), "{}", info.libode_version);
+}
+
+#[test]
 fn simulate_writes_the_trajectory_csv() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("traj.csv");
@@ -165,13 +180,13 @@ fn spin_damper() -> psa_esp::network::Network {
 
 #[test]
 fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
-    use psa_esp::psa::{NetworkFile, SensorSettings, Task};
+    use psa_esp::psa::{NetworkFile, PsaSettings, Task};
     let dir = tempfile::tempdir().unwrap();
     let net_path = dir.path().join("damper.json");
     NetworkFile::new(
         &spin_damper(),
         Task::StopRotation,
-        SensorSettings::default(),
+        &PsaSettings::default(),
         serde_json::Map::new(),
     )
     .save(&net_path)

@@ -33,7 +33,7 @@ fn esp_solves_xor_within_its_budget() {
         subpop_size: 20,
         initial_hidden: 4,
         generations: 200,
-        ..EspSettings::default()
+        ..EspSettings::hoverstad()
     };
     for seed in 1..=5 {
         let result = Esp::new(settings.clone(), seed).unwrap().run(&xor(), |_| {}).unwrap();

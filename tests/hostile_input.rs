@@ -16,7 +16,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use psa_esp::network::Network;
-use psa_esp::psa::{NetworkFile, SensorSettings, Task};
+use psa_esp::psa::{NetworkFile, PsaSettings, SensorSettings, Task};
 
 /// The most one row may take; each takes well under a second.
 const TIME_LIMIT: Duration = Duration::from_secs(60);
@@ -170,7 +170,11 @@ fn make_fifo(path: &Path) {
 
 fn save_network(path: &Path, scaling: SensorSettings) {
     let network = Network::from_genes(7, 4, vec![0.5; 2 * 11]).unwrap();
-    NetworkFile::new(&network, Task::StopRotation, scaling, serde_json::Map::new())
+    let problem = PsaSettings {
+        sensors: scaling,
+        ..PsaSettings::default()
+    };
+    NetworkFile::new(&network, Task::StopRotation, &problem, serde_json::Map::new())
         .save(path)
         .unwrap();
 }

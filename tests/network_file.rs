@@ -1,7 +1,7 @@
 //! Network files: exact round trips, and a clear error for each kind of malformed file.
 
 use psa_esp::network::Network;
-use psa_esp::psa::{NetworkFile, SensorSettings, Task};
+use psa_esp::psa::{NetworkFile, PsaSettings, Task};
 use rand::RngExt;
 
 fn sample_network() -> Network {
@@ -23,7 +23,7 @@ fn save_and_load_round_trip_exactly() {
     let net = sample_network();
     let mut extra = serde_json::Map::new();
     extra.insert("seed".into(), 42.into());
-    let file = NetworkFile::new(&net, Task::StopAtPosition, SensorSettings::default(), extra);
+    let file = NetworkFile::new(&net, Task::StopAtPosition, &PsaSettings::default(), extra);
     file.save(&path).unwrap();
     let (loaded_file, loaded) = NetworkFile::load(&path).unwrap();
     assert_eq!(loaded, net);
@@ -48,7 +48,7 @@ fn valid_json() -> serde_json::Value {
     let file = NetworkFile::new(
         &sample_network(),
         Task::Turn,
-        SensorSettings::default(),
+        &PsaSettings::default(),
         serde_json::Map::new(),
     );
     serde_json::to_value(&file).unwrap()

@@ -97,20 +97,20 @@ fn a_hand_built_trajectory_scores_step_by_step() {
         .run_trial(&constant_network(0.0), &mut stream(1, &[]), Some(&mut record))
         .unwrap();
     assert_eq!(record.states.len(), 501);
-    // Coasting at 0.1 m/s along +y: in the box (|y - 0.4| < 0.2) for steps
-    // 41..=119 in exact arithmetic (step 40 sits on the edge, y = 0.2, and
-    // rounding decides it), never on heading.
+    // Coasting at 0.3 m/s along +y on the target heading: in the box
+    // (|y - 0.4| < 0.2) for steps 14..=39 in exact arithmetic (step 40 sits
+    // on the edge, y = 0.6, and rounding decides it), 4 points each.
     for (n, p) in record.points.iter().enumerate() {
         let y = record.states[n + 1].y;
-        let expected = if (y - 0.4).abs() < 0.2 { 1.0 } else { 0.0 };
+        let expected = if (y - 0.4).abs() < 0.2 { 4.0 } else { 0.0 };
         assert_eq!(*p, expected, "step {}", n + 1);
     }
     assert_eq!(total, record.points.iter().sum::<f64>());
-    assert!(total == 79.0 || total == 80.0, "{total}");
+    assert!(total == 104.0 || total == 108.0, "{total}");
 }
 
 #[test]
-fn doing_nothing_scores_0_25_and_4_percent() {
+fn doing_nothing_scores_0_0_and_the_coasting_points_of_task_3() {
     for backend in [BackendKind::Ode, BackendKind::Native] {
         let settings = PsaSettings {
             backend,
@@ -124,20 +124,23 @@ fn doing_nothing_scores_0_25_and_4_percent() {
         );
         assert_eq!(
             fitness(&settings, Task::Turn, &idle, 1),
-            25.0,
-            "{backend}: in the box, never turned"
+            0.0,
+            "{backend}: it spins past the target heading forever"
         );
+        // Coasting at 0.3 m/s on heading 0 through the box (0.2 m to 0.6 m):
+        // 4 points for each of the 26 or 27 steps inside it, of 2000.
         let t3 = fitness(&settings, Task::StopAtPosition, &idle, 1);
-        assert!((3.95..=4.0).contains(&t3), "{backend}: coasting through the box: {t3}");
+        assert!((5.2..=5.4).contains(&t3), "{backend}: coasting through the box: {t3}");
     }
 }
 
 #[test]
-fn firing_every_thruster_fully_scores_under_1_percent() {
+fn firing_every_thruster_fully_scores_under_2_percent() {
     let full = constant_network(1.0);
     for task in Task::ALL {
+        // Task 3: it shoots through the box on the target heading (4 points a step).
         let f = fitness(&PsaSettings::default(), task, &full, 1);
-        assert!(f < 1.0, "task {task}: {f}");
+        assert!(f < 2.0, "task {task}: {f}");
     }
 }
 
@@ -287,7 +290,10 @@ fn start_states_and_targets_are_as_specified() {
     assert_eq!(
         (s2, g2),
         (
-            BodyState::default(),
+            BodyState {
+                omega: 1.0,
+                ..BodyState::default()
+            },
             Target {
                 heading: FRAC_PI_2,
                 ..Target::default()
@@ -298,7 +304,7 @@ fn start_states_and_targets_are_as_specified() {
     assert_eq!(
         s3,
         BodyState {
-            vy: 0.1,
+            vy: 0.3,
             ..BodyState::default()
         }
     );
@@ -307,7 +313,7 @@ fn start_states_and_targets_are_as_specified() {
         Target {
             x: 0.0,
             y: 0.40,
-            heading: PI
+            heading: 0.0
         }
     );
     // Random initialisation: task 1 heading uniform in (-pi, pi], task 3 distance uniform in [0.25, 0.55].

@@ -16,8 +16,7 @@ mod replay;
 mod replicate;
 mod report;
 mod simulate;
-
-use std::fmt::Write as _;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 
@@ -28,7 +27,7 @@ pub const EXIT_ERROR: i32 = 2;
 
 /// Evolving neural controllers for the Personal Satellite Assistant.
 #[derive(Debug, Parser)]
-#[command(name = "psa-esp", version, about, long_about = None)]
+#[command(name = "psa-esp", version = crate::provenance::VERSION, about, long_about = None)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -46,6 +45,8 @@ pub enum Command {
     Evolve(evolve::EvolveArgs),
     /// Run the paper's experiment grid (resumable).
     Replicate(replicate::ReplicateArgs),
+    /// Run the grid once for each value (or combination of values) of any settings (resumable).
+    Sweep(sweep::SweepArgs),
     /// Compare a grid's results with the paper's tables: report.md, figures, and CSV or JSON.
     Report(report::ReportArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
@@ -61,6 +62,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
         Command::Crosscheck(args) => crosscheck::run(args),
         Command::Evolve(args) => evolve::run(args),
         Command::Replicate(args) => replicate::run(args),
+        Command::Sweep(args) => sweep::run(args),
         Command::Report(args) => report::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),

@@ -40,6 +40,14 @@ pub struct ReplayArgs {
     /// Seed of the noise and random initial conditions.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// A TOML file of settings (as for `evolve --config`) laid over the
+    /// model the network was evolved under; its `problem` table applies.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Fly the network on this build's default model instead of the one
+    /// recorded in the network file.
+    #[arg(long)]
+    pub default_model: bool,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -94,6 +102,30 @@ fn write_outputs(dir: &Path, record: &TrialRecord, settings: &PsaSettings, title
     Ok(files)
 }
 
+/// The model to fly on: the one the file records (for files of older
+/// builds, the default model with the file's input scaling), or the
+/// default with `--default-model`; then `--config` laid over it.
+fn model(args: &ReplayArgs, file: &NetworkFile) -> Result<PsaSettings> {
+    let recorded = match (&file.problem, args.default_model) {
+        (_, true) => PsaSettings::default(),
+        (Some(problem), false) => problem.clone(),
+        (None, false) => PsaSettings {
+            sensors: file.input_scaling,
+            ..PsaSettings::default()
+        },
+    };
+    match &args.config {
+        None => Ok(recorded),
+        Some(path) => {
+            let base = crate::experiment::RunConfig {
+                problem: recorded,
+                ..crate::experiment::RunConfig::default()
+            };
+            Ok(base.with_overrides_from(path)?.problem)
+        }
+    }
+}
+
 /// Runs `replay`.
 pub fn run(args: ReplayArgs) -> Result<i32> {
     check_as("noise.input_sd", "--input-noise", args.input_noise).map_err(anyhow::Error::msg)?;
@@ -107,12 +139,11 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
         backend: args.backend,
         trials: args.trials as usize,
         random_init: args.random_init,
-        sensors: file.input_scaling,
         noise: NoiseSettings {
             input_sd: args.input_noise,
             output_sd: args.output_noise,
         },
-        ..PsaSettings::default()
+        ..model(&args, &file)?
     };
     let mut runner = TrialRunner::new(&settings, task)?;
     let mut rng = crate::rng::stream(args.seed, &[REPLAY_STREAM]);

@@ -18,6 +18,17 @@ use crate::psa::Task;
 /// Arguments of `replicate`.
 #[derive(Debug, clap::Args)]
 pub struct ReplicateArgs {
+    /// The grid.
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// The grid's directory; running the same command again resumes it.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// The options that define a grid (shared by `replicate` and `sweep`).
+#[derive(Debug, clap::Args)]
+pub struct GridArgs {
     /// quick: a reduced grid (5 seeds, 80 generations, 100-trial robustness,
     /// native backend; about a minute on 2 cores); paper: the full protocol
     /// (30 seeds, 2000 generations, 500-trial robustness, ode backend).
@@ -42,18 +53,22 @@ pub struct ReplicateArgs {
     /// Trials of each robustness test (at most 1,000,000).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_TRIALS))]
     pub robustness_trials: Option<u64>,
+    /// A TOML file of settings laid over every configuration of the grid
+    /// (before each configuration's own change); recorded in grid.json.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
     /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
     pub jobs: u64,
-    /// The grid's directory; running the same command again resumes it.
-    #[arg(long)]
-    pub out: PathBuf,
 }
 
-impl ReplicateArgs {
+impl GridArgs {
     /// The grid these options describe.
-    pub fn spec(&self) -> GridSpec {
+    pub fn spec(&self) -> Result<GridSpec> {
         let mut spec = GridSpec::from_preset(self.preset);
+        if let Some(path) = &self.config {
+            spec.overrides = Some(read_overrides(path)?);
+        }
         if let Some(c) = &self.configs {
             spec.configs = c.clone();
         }
@@ -64,14 +79,42 @@ impl ReplicateArgs {
         spec.generations = self.generations.map_or(spec.generations, |g| g as usize);
         spec.backend = self.backend.unwrap_or(spec.backend);
         spec.robustness_trials = self.robustness_trials.map_or(spec.robustness_trials, |t| t as usize);
-        spec
+        Ok(spec)
     }
 }
 
+/// The text of a `--config` file, checked to be a valid overlay of the baseline.
+pub fn read_overrides(path: &std::path::Path) -> Result<String> {
+    use anyhow::Context;
+    let text = crate::io::read_input(path, "configuration")?;
+    crate::experiment::RunConfig::baseline_with(&text).with_context(|| format!("configuration {}", path.display()))?;
+    Ok(text)
+}
+
 /// A bar over the whole grid and a line per finished run (both only on a terminal).
-struct Progress {
-    bar: indicatif::ProgressBar,
+pub struct Progress {
+    /// The bar.
+    pub bar: indicatif::ProgressBar,
     best: Mutex<f64>,
+}
+
+impl Default for Progress {
+    fn default() -> Self {
+        Progress::new()
+    }
+}
+
+impl Progress {
+    /// A bar with no runs yet.
+    pub fn new() -> Progress {
+        Progress {
+            bar: progress_bar(
+                0,
+                "{spinner} runs {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
+            ),
+            best: Mutex::new(f64::NEG_INFINITY),
+        }
+    }
 }
 
 impl GridProgress for Progress {
@@ -95,15 +138,9 @@ impl GridProgress for Progress {
 
 /// Runs `replicate`.
 pub fn run(args: ReplicateArgs) -> Result<i32> {
-    let spec = args.spec();
-    let progress = Progress {
-        bar: progress_bar(
-            0,
-            "{spinner} runs {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
-        ),
-        best: Mutex::new(f64::NEG_INFINITY),
-    };
-    let summary = replicate(&args.out, &spec, args.jobs as usize, &progress)?;
+    let spec = args.grid.spec()?;
+    let progress = Progress::new();
+    let summary = replicate(&args.out, &spec, args.grid.jobs as usize, &progress)?;
     progress.bar.finish_and_clear();
     say!(
         "grid {} ({}): {} runs, {} already finished, {} run now in {:.0} s",

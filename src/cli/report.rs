@@ -9,7 +9,8 @@ use crate::experiment::report::{write_report, ReportFormat};
 /// Arguments of `report`.
 #[derive(Debug, clap::Args)]
 pub struct ReportArgs {
-    /// The grid directory written by `psa-esp replicate` (holds grid.json).
+    /// The grid directory written by `psa-esp replicate` (holds grid.json),
+    /// or a sweep's directory (holds sweep.json: writes sweep-report.md and .json).
     pub dir: PathBuf,
     /// md: write report.md and print it; csv: also report.csv (one row per
     /// table cell); json: also report.json (the whole report). The figures
@@ -22,6 +23,14 @@ pub struct ReportArgs {
 /// another configuration (the report is written all the same, without it).
 /// A directory that is not a grid is an error (exit code 2).
 pub fn run(args: ReportArgs) -> Result<i32> {
+    if crate::experiment::sweep::sweep_file(&args.dir).exists() {
+        let (_, markdown, written) = crate::experiment::report::write_sweep_report(&args.dir)?;
+        say!("{}", markdown.trim_end());
+        for path in written {
+            eprintln!("wrote {}", path.display());
+        }
+        return Ok(0);
+    }
     let outcome = write_report(&args.dir, args.format)?;
     if args.format == ReportFormat::Md {
         say!("{}", outcome.markdown.trim_end());

@@ -1,7 +1,7 @@
 //! `psa-esp simulate`: the PSA under given thrust, trajectory as CSV.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 
@@ -54,7 +54,7 @@ const DEFAULT_STEPS: u64 = 500;
 /// of ODE; the trajectory is streamed, so only time and disk grow with it.
 pub const MAX_STEPS: u64 = 1_000_000_000;
 
-fn read_thrust_file(path: &PathBuf) -> Result<Vec<Vec<f64>>> {
+fn read_thrust_file(path: &Path) -> Result<Vec<Vec<f64>>> {
     let text = crate::io::read_input(path, "thrust file")?;
     let mut rows = Vec::new();
     for (number, line) in text.lines().enumerate() {

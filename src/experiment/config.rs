@@ -41,6 +41,35 @@ impl Default for RunConfig {
     }
 }
 
+/// ESP's settings for the PSA, the paper's baseline (its Table 1):
+/// Høverstad's ESP with 5 sub-populations of 40 neurons at first, 10
+/// networks per neuron (400 a generation) and 2000 generations; the
+/// stagnation of 40 generations is fitted to the paper's burst totals
+/// (docs/model.md).
+pub fn paper_esp_settings() -> EspSettings {
+    EspSettings {
+        subpop_size: 40,
+        trials_per_neuron: 10,
+        initial_hidden: 5,
+        generations: 2000,
+        init_range: 6.0,
+        stagnation: 40,
+        ..EspSettings::hoverstad()
+    }
+}
+
+impl RunConfig {
+    /// The baseline: ESP, every setting at its default.
+    fn base() -> RunConfig {
+        RunConfig {
+            algorithm: Algorithm::Esp,
+            esp: paper_esp_settings(),
+            hill_climb: HillClimbSettings::default(),
+            problem: PsaSettings::default(),
+        }
+    }
+}
+
 /// One configuration of the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
@@ -88,13 +117,11 @@ impl Preset {
 
     /// The configuration: the baseline with this preset's one change.
     pub fn config(self) -> RunConfig {
-        let esp = EspSettings::default();
-        let mut config = RunConfig {
-            algorithm: Algorithm::Esp,
-            esp: esp.clone(),
-            hill_climb: HillClimbSettings::default(),
-            problem: PsaSettings::default(),
-        };
+        self.apply(RunConfig::base())
+    }
+
+    /// `config` with this preset's one change.
+    pub fn apply(self, mut config: RunConfig) -> RunConfig {
         match self {
             Preset::Baseline => {}
             Preset::Systematic => config.esp.sampling = Sampling::Systematic,
@@ -148,6 +175,11 @@ impl RunConfig {
         self.hill_climb.validate().map_err(anyhow::Error::msg)?;
         self.problem.validate().context("problem")?;
         Ok(())
+    }
+
+    /// The baseline with the settings of a TOML document laid over it.
+    pub fn baseline_with(toml_text: &str) -> Result<RunConfig> {
+        RunConfig::base().with_overrides(toml_text)
     }
 
     /// This configuration with the settings of a TOML document laid over it;
@@ -236,16 +268,22 @@ impl GridConfig {
 
     /// The run configuration.
     pub fn config(self) -> RunConfig {
+        self.apply(RunConfig::base())
+    }
+
+    /// `base` (a configuration of the baseline, such as one with a file's
+    /// settings laid over it) with this configuration's change.
+    pub fn apply(self, base: RunConfig) -> RunConfig {
         match self {
-            GridConfig::Preset(p) => p.config(),
+            GridConfig::Preset(p) => p.apply(base),
             GridConfig::InputNoise => {
-                let mut c = Preset::Baseline.config();
+                let mut c = base;
                 c.problem.noise.input_sd = PAPER_NOISE_SD;
                 c.problem.trials = PAPER_NOISY_TRIALS;
                 c
             }
             GridConfig::RandomInit => {
-                let mut c = Preset::Baseline.config();
+                let mut c = base;
                 c.problem.random_init = true;
                 c.problem.trials = PAPER_NOISY_TRIALS;
                 c

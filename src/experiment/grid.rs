@@ -60,6 +60,10 @@ pub struct GridSpec {
     pub backend: BackendKind,
     /// Trials of each robustness test.
     pub robustness_trials: usize,
+    /// Settings laid over every configuration of the grid before its own
+    /// change (a TOML document, as `--config` files are written).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overrides: Option<String>,
 }
 
 /// The folder status of one run.
@@ -101,6 +105,7 @@ impl GridSpec {
             generations,
             backend,
             robustness_trials,
+            overrides: None,
         }
     }
 
@@ -133,6 +138,9 @@ impl GridSpec {
         if !self.backend.is_available() {
             bail!("backend {} is not available in this build", self.backend);
         }
+        for &config in &self.configs {
+            self.run_config(config)?;
+        }
         Ok(())
     }
 
@@ -153,42 +161,31 @@ impl GridSpec {
     }
 
     /// The full configuration a run of `config` uses in this grid.
-    pub fn run_config(&self, config: GridConfig) -> RunConfig {
-        let mut c = config.config();
+    pub fn run_config(&self, config: GridConfig) -> Result<RunConfig> {
+        let base = match &self.overrides {
+            Some(text) => RunConfig::baseline_with(text).context("the grid's configuration overrides")?,
+            None => RunConfig::default(),
+        };
+        let mut c = config.apply(base);
         c.esp.generations = self.generations;
         c.hill_climb.cycles = self.generations;
         c.problem.backend = self.backend;
-        c
+        c.validate()
+            .with_context(|| format!("configuration {config} with the grid's overrides"))?;
+        Ok(c)
     }
 
     /// Reads `DIR/grid.json`, checking its format and version.
     pub fn load(dir: &Path) -> Result<GridSpec> {
         let path = grid_file(dir);
-        let text = crate::io::read_input(&path, "grid file")?;
-        let value: serde_json::Value =
-            serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
-        if value.get("format").and_then(|f| f.as_str()) != Some(GRID_FORMAT) {
-            bail!(
-                "{}: not a psa-esp grid file (no \"format\": {GRID_FORMAT:?})",
-                path.display()
-            );
-        }
-        if value.get("version").and_then(|v| v.as_u64()) != Some(GRID_VERSION as u64) {
-            bail!(
-                "{}: unknown grid version; this build reads version {GRID_VERSION}",
-                path.display()
-            );
-        }
-        let spec: GridSpec = serde_json::from_value(value).with_context(|| format!("{}", path.display()))?;
+        let spec: GridSpec = crate::io::read_versioned_json(&path, GRID_FORMAT, GRID_VERSION, "grid")?;
         spec.validate().with_context(|| format!("{}", path.display()))?;
         Ok(spec)
     }
 
     /// Writes `DIR/grid.json` atomically.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        let mut json = serde_json::to_string_pretty(self)?;
-        json.push('\n');
-        crate::io::write_atomic(&grid_file(dir), json.as_bytes())
+        crate::io::write_json(&grid_file(dir), self)
     }
 }
 
@@ -222,7 +219,7 @@ pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus
         return Ok(RunStatus::Unfinished);
     }
     let text = crate::io::read_input(&config_path, "run configuration")?;
-    let expected = spec.run_config(key.config);
+    let expected = spec.run_config(key.config)?;
     let found = RunConfig::default()
         .with_overrides(&text)
         .with_context(|| format!("{}: damaged configuration", config_path.display()))?;

@@ -125,7 +125,7 @@ pub fn describe(spec: &GridSpec) -> String {
 /// written last, marks it finished.
 pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
-    let config = spec.run_config(key.config);
+    let config = spec.run_config(key.config)?;
     let seed = run_seed(key);
     let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, |_| {})
         .with_context(|| format!("run {}", folder.display()))?;

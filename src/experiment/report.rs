@@ -9,10 +9,12 @@
 //! error); a damaged folder or one holding another configuration is listed
 //! under "Problems" with its path and not counted.
 
+mod distance;
 mod figures;
 mod findings;
 mod paper;
 mod render;
+mod sweep;
 mod tables;
 #[cfg(test)]
 mod tests;
@@ -27,8 +29,10 @@ use super::robustness::Robustness;
 use super::GridConfig;
 use crate::psa::Task;
 
+pub use distance::{Distance, Term};
 pub use findings::{Finding, Rule, Verdict, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
 pub use paper::{paper_bursts, paper_cell, PaperCell, PAPER_BURSTS, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK};
+pub use sweep::{write_sweep_report, SweepReport};
 pub use tables::{BurstRow, FigureLink, MissingCell, Report, Row, Table};
 
 /// Which files `psa-esp report` writes besides `report.md`.

@@ -124,7 +124,7 @@ pub fn run_evolution(
     extra.insert("fitness_percent".into(), champion.fitness.into());
     extra.insert("generation".into(), champion.generation.into());
     extra.insert("backend".into(), config.problem.backend.name().into());
-    NetworkFile::new(&champion.network, task, config.problem.sensors, extra).save(&files.champion)?;
+    NetworkFile::new(&champion.network, task, &config.problem, extra).save(&files.champion)?;
     let last = result.records.last().context("a run has at least one generation")?;
     let outcome = EvolveOutcome {
         task,

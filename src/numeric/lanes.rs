@@ -5,7 +5,9 @@
 
 use std::ops::{Add, BitAnd, BitOr, Div, Index, IndexMut, Mul, Neg, Not, Sub};
 
-use super::{exp2_int_of, exponent_of, mantissa_of, unit_from_bits, Real};
+use esp_neuroevolution::math::exp2_int_of;
+
+use super::{exponent_of, mantissa_of, unit_from_bits, Float, Real};
 
 /// N `f64` values, one per lane.
 ///
@@ -136,12 +138,32 @@ fn truth(b: bool) -> u64 {
     }
 }
 
-impl<const N: usize> Real for Lanes<N> {
+impl<const N: usize> Float for Lanes<N> {
     type Mask = LaneMask<N>;
     #[inline(always)]
     fn splat(v: f64) -> Self {
         Lanes([v; N])
     }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        Lanes(from_fn(|i| self.0[i].mul_add(a.0[i], b.0[i])))
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> LaneMask<N> {
+        LaneMask(from_fn(|i| truth(self.0[i] < other.0[i])))
+    }
+    #[inline(always)]
+    fn select(mask: LaneMask<N>, if_true: Self, if_false: Self) -> Self {
+        let (t, f) = (if_true.bits(), if_false.bits());
+        Self::from_bits(from_fn(|i| (t[i] & mask.0[i]) | (f[i] & !mask.0[i])))
+    }
+    #[inline(always)]
+    fn exp2_int(k: Self) -> Self {
+        Lanes(from_fn(|i| exp2_int_of(k.0[i])))
+    }
+}
+
+impl<const N: usize> Real for Lanes<N> {
     #[inline(always)]
     fn abs(self) -> Self {
         let b = self.bits();
@@ -152,30 +174,13 @@ impl<const N: usize> Real for Lanes<N> {
         Lanes(from_fn(|i| self.0[i].sqrt()))
     }
     #[inline(always)]
-    fn mul_add(self, a: Self, b: Self) -> Self {
-        Lanes(from_fn(|i| self.0[i].mul_add(a.0[i], b.0[i])))
-    }
-    #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
         let (m, s) = (self.bits(), sign.bits());
         Self::from_bits(from_fn(|i| (m[i] & !SIGN_BIT) | (s[i] & SIGN_BIT)))
     }
     #[inline(always)]
-    fn lt(self, other: Self) -> LaneMask<N> {
-        LaneMask(from_fn(|i| truth(self.0[i] < other.0[i])))
-    }
-    #[inline(always)]
     fn le(self, other: Self) -> LaneMask<N> {
         LaneMask(from_fn(|i| truth(self.0[i] <= other.0[i])))
-    }
-    #[inline(always)]
-    fn select(mask: LaneMask<N>, if_true: Self, if_false: Self) -> Self {
-        let (t, f) = (if_true.bits(), if_false.bits());
-        Self::from_bits(from_fn(|i| (t[i] & mask.0[i]) | (f[i] & !mask.0[i])))
-    }
-    #[inline(always)]
-    fn exp2_int(k: Self) -> Self {
-        Lanes(from_fn(|i| exp2_int_of(k.0[i])))
     }
     #[inline(always)]
     fn all(mask: LaneMask<N>) -> bool {

@@ -9,31 +9,13 @@
 //! sine and cosine of quarter turns (Taylor series) serve the noise
 //! generator's Box-Muller transform.
 
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, LOG2_E, PI, SQRT_2, TAU};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, SQRT_2, TAU};
+
+pub use esp_neuroevolution::math::{exp, sigmoid};
+use esp_neuroevolution::math::{horner, LN2_HI, LN2_LO};
 
 use super::Real;
 
-/// 1.5 * 2^52: adding and subtracting it rounds to the nearest integer.
-const ROUNDER: f64 = 6755399441055744.0;
-/// ln 2 split so that k * LN2_HI is exact for |k| < 2^11 (fdlibm's split).
-const LN2_HI: f64 = 6.931_471_803_691_238e-1;
-const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
-/// Arguments beyond these give 2^k outside the normal range.
-const EXP_ARGUMENT_LIMIT: f64 = 708.0;
-/// e^r = 1 + r + r^2 q(r) on |r| <= ln2/2: q's coefficients, highest first
-/// (relative error of the fit 1.8e-17).
-const EXP_Q: [f64; 10] = [
-    2.510_037_583_256_123_4e-8,
-    2.762_007_587_998_336_7e-7,
-    2.755_726_848_031_002_4e-6,
-    2.480_152_132_236_869_2e-5,
-    1.984_126_986_304_054_5e-4,
-    1.388_888_891_719_671_9e-3,
-    8.333_333_333_330_065e-3,
-    4.166_666_666_662_416_4e-2,
-    1.666_666_666_666_666_9e-1,
-    5.000_000_000_000_001e-1,
-];
 /// atan(t) = t + t z s(z), z = t^2 <= tan^2(pi/8): s's coefficients, highest
 /// first (error of the fit 5.4e-18).
 const ATAN_S: [f64; 11] = [
@@ -88,36 +70,6 @@ const COS_QUARTER: [f64; 9] = [
     -1.233_700_550_136_169_7,
     1.0,
 ];
-
-/// Horner's scheme, highest coefficient first.
-#[inline(always)]
-fn horner<R: Real>(x: R, coefficients: &[f64]) -> R {
-    let mut acc = R::splat(coefficients[0]);
-    for &c in &coefficients[1..] {
-        acc = acc.mul_add(x, R::splat(c));
-    }
-    acc
-}
-
-/// e^x. Arguments are clamped to [-708, 708] first, so the result is always
-/// finite and positive (e^-708 is about 3e-308).
-#[inline(always)]
-pub fn exp<R: Real>(x: R) -> R {
-    let limit = R::splat(EXP_ARGUMENT_LIMIT);
-    let x = R::select(x.lt(-limit), -limit, x);
-    let x = R::select(limit.lt(x), limit, x);
-    let rounder = R::splat(ROUNDER);
-    let k = x.mul_add(R::splat(LOG2_E), rounder) - rounder;
-    let r = k.mul_add(R::splat(-LN2_LO), k.mul_add(R::splat(-LN2_HI), x));
-    let e_r = R::splat(1.0) + (r * r).mul_add(horner(r, &EXP_Q), r);
-    e_r * R::exp2_int(k)
-}
-
-/// The logistic function 1 / (1 + e^-x).
-#[inline(always)]
-pub fn sigmoid<R: Real>(x: R) -> R {
-    R::splat(1.0) / (R::splat(1.0) + exp(-x))
-}
 
 /// The natural logarithm of a positive normal number (fdlibm's algorithm:
 /// x = m 2^e with m in [sqrt(1/2), sqrt(2)), then a polynomial in
@@ -197,6 +149,7 @@ pub fn clamp_unit<R: Real>(u: R) -> R {
 mod tests {
     use super::super::Lanes;
     use super::*;
+    use esp_neuroevolution::math::Float;
 
     fn ulps(a: f64, b: f64) -> u64 {
         (a.to_bits() as i64).abs_diff(b.to_bits() as i64)
@@ -205,29 +158,6 @@ mod tests {
     /// Evenly spread and random-looking test points in [lo, hi].
     fn points(lo: f64, hi: f64, n: usize) -> impl Iterator<Item = f64> {
         (0..n).map(move |i| lo + (hi - lo) * ((i as f64 * 0.618_033_988_749_894_9) % 1.0))
-    }
-
-    #[test]
-    fn exp_is_within_two_ulps_of_the_c_library() {
-        for x in points(-700.0, 700.0, 200_000).chain(points(-1.0, 1.0, 100_000)) {
-            assert!(ulps(exp(x), x.exp()) <= 2, "exp({x}) = {} vs {}", exp(x), x.exp());
-        }
-        assert_eq!(exp(0.0), 1.0);
-        assert_eq!(exp(-0.0), 1.0);
-        assert_eq!(exp(f64::INFINITY), exp(EXP_ARGUMENT_LIMIT));
-        assert!(exp(-1e6) > 0.0 && exp(1e6).is_finite());
-    }
-
-    #[test]
-    fn sigmoid_saturates_and_is_symmetric() {
-        assert_eq!(sigmoid(0.0), 0.5);
-        assert_eq!(sigmoid(40.0), 1.0);
-        assert!(sigmoid(-40.0) > 0.0 && sigmoid(-40.0) < 1e-17);
-        for x in points(-30.0, 30.0, 10_000) {
-            let exact = 1.0 / (1.0 + (-x).exp());
-            assert!((sigmoid(x) - exact).abs() <= 4.0 * f64::EPSILON * exact, "sigmoid({x})");
-            assert!((sigmoid(x) + sigmoid(-x) - 1.0).abs() <= 2.0 * f64::EPSILON);
-        }
     }
 
     #[test]

@@ -25,37 +25,25 @@ mod lanes;
 mod math;
 mod normal;
 
-use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
-
 pub use dispatch::SimdLevel;
+pub use esp_neuroevolution::math::Float;
+use esp_neuroevolution::math::TWO_52;
 pub use lanes::{LaneMask, Lanes, Words};
 pub use math::{atan2, clamp_unit, exp, fmod, ln, sigmoid, sin_cos_quarter_turns, wrap_angle};
 pub use normal::{NoiseSource, Word};
 
-/// A real number, or a bundle of them computed lane by lane.
-pub trait Real:
-    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
-{
-    /// The result of a comparison: one truth value per lane.
-    type Mask: Copy + BitAnd<Output = Self::Mask> + BitOr<Output = Self::Mask> + Not<Output = Self::Mask>;
-    /// `v` in every lane.
-    fn splat(v: f64) -> Self;
+/// A real number, or a bundle of them computed lane by lane: the search
+/// crate's [`Float`] (what the network's activation needs) and the rest of
+/// the PSA's per-step arithmetic.
+pub trait Real: Float {
     /// Absolute value (clears the sign bit).
     fn abs(self) -> Self;
     /// Correctly rounded square root.
     fn sqrt(self) -> Self;
-    /// `self * a + b` with one rounding (fused multiply-add).
-    fn mul_add(self, a: Self, b: Self) -> Self;
     /// The magnitude of `self` with the sign bit of `sign`.
     fn copysign(self, sign: Self) -> Self;
-    /// `self < other` (false when either is NaN).
-    fn lt(self, other: Self) -> Self::Mask;
     /// `self <= other` (false when either is NaN).
     fn le(self, other: Self) -> Self::Mask;
-    /// `if_true` where `mask` holds, else `if_false`.
-    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
-    /// 2^k for an integral `k` in [-1022, 1023], built from its bits.
-    fn exp2_int(k: Self) -> Self;
     /// Whether `mask` holds in every lane.
     fn all(mask: Self::Mask) -> bool;
     /// The remainder `self % m`, lane by lane (C's `fmod`, which is exact).
@@ -75,8 +63,6 @@ pub trait Real:
 const ONE_BITS: u64 = 0x3FF0_0000_0000_0000;
 /// The mantissa field of an `f64`.
 const MANTISSA_BITS: u64 = (1 << 52) - 1;
-/// 2^52: a value in [2^52, 2^53) holds an integer in its mantissa bits.
-const TWO_52: f64 = 4_503_599_627_370_496.0;
 
 /// [`Real::unit_from_word`] of one word.
 #[inline(always)]
@@ -100,24 +86,7 @@ fn exponent_of(x: f64) -> f64 {
     biased - (TWO_52 + 1023.0)
 }
 
-/// [`Real::exp2_int`] of one integral `k` in [-1022, 1023]: the exact sum
-/// `k + 1023 + 2^52` holds k + 1023 in its low mantissa bits, which become
-/// the exponent field (one addition and integer operations, so it
-/// vectorises on every level, and the scalar path needs no float-to-integer
-/// conversion). Outside that range (a NaN from `exp`'s argument) the bits
-/// wrap and the result is meaningless, never a panic.
-#[inline(always)]
-fn exp2_int_of(k: f64) -> f64 {
-    let shifted = (k + (TWO_52 + 1023.0)).to_bits();
-    f64::from_bits(shifted.wrapping_sub(TWO_52.to_bits()) << 52)
-}
-
 impl Real for f64 {
-    type Mask = bool;
-    #[inline(always)]
-    fn splat(v: f64) -> f64 {
-        v
-    }
     #[inline(always)]
     fn abs(self) -> f64 {
         f64::abs(self)
@@ -127,32 +96,12 @@ impl Real for f64 {
         f64::sqrt(self)
     }
     #[inline(always)]
-    fn mul_add(self, a: f64, b: f64) -> f64 {
-        f64::mul_add(self, a, b)
-    }
-    #[inline(always)]
     fn copysign(self, sign: f64) -> f64 {
         f64::copysign(self, sign)
     }
     #[inline(always)]
-    fn lt(self, other: f64) -> bool {
-        self < other
-    }
-    #[inline(always)]
     fn le(self, other: f64) -> bool {
         self <= other
-    }
-    #[inline(always)]
-    fn select(mask: bool, if_true: f64, if_false: f64) -> f64 {
-        if mask {
-            if_true
-        } else {
-            if_false
-        }
-    }
-    #[inline(always)]
-    fn exp2_int(k: f64) -> f64 {
-        exp2_int_of(k)
     }
     #[inline(always)]
     fn all(mask: bool) -> bool {

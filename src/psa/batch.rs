@@ -33,7 +33,7 @@ use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use std::ops::Range;
 
 use crate::network::NetworkSet;
-use crate::numeric::{clamp_unit, sigmoid, wrap_angle, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words};
+use crate::numeric::{clamp_unit, sigmoid, wrap_angle, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::Stream;
 

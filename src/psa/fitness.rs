@@ -14,6 +14,16 @@ pub enum FitnessKind {
     Original,
 }
 
+/// How the incremental fitness reads the paper's "omega_t < omega_t-1".
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlowingRule {
+    /// The spin's magnitude falls: |omega_t| < |omega_t-1|. `[chosen]`
+    Magnitude,
+    /// The paper's formula as printed, signed: omega_t < omega_t-1.
+    Signed,
+}
+
 /// The fitness function and its windows.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -26,6 +36,8 @@ pub struct FitnessSettings {
     pub heading_window: f64,
     /// Spin window: |omega| below it (rad/s). `[paper]` 0.05
     pub spin_window: f64,
+    /// What counts as the spin slowing down. `[chosen]` magnitude
+    pub slowing: SlowingRule,
     /// Points for being in the box with the spin under control. `[paper]` 1
     pub position_points: f64,
     /// Extra points for also being on heading. `[paper]` 3
@@ -39,6 +51,7 @@ impl Default for FitnessSettings {
             box_half_width: 0.2,
             heading_window: 0.05,
             spin_window: 0.05,
+            slowing: SlowingRule::Magnitude,
             position_points: 1.0,
             heading_points: 3.0,
         }
@@ -84,9 +97,12 @@ impl FitnessSettings {
         match self.kind {
             FitnessKind::Original => R::select(in_box & on_heading, R::splat(self.position_points), zero),
             FitnessKind::Incremental => {
-                // [chosen] reading of the paper's "omega_t < omega_t-1": the spin's magnitude falls.
                 let spin = e.omega.abs();
-                let spin_ok = spin.lt(R::splat(self.spin_window)) | spin.lt(e.previous_omega.abs());
+                let slowing = match self.slowing {
+                    SlowingRule::Magnitude => spin.lt(e.previous_omega.abs()),
+                    SlowingRule::Signed => e.omega.lt(e.previous_omega),
+                };
+                let spin_ok = spin.lt(R::splat(self.spin_window)) | slowing;
                 let earned = R::select(
                     on_heading,
                     R::splat(self.position_points + self.heading_points),

@@ -145,6 +145,8 @@ pub const LIMITS: &[Limit] = &[
     ),
     row("tasks.task1_spin", SPIN, "rad/s", SPIN_WHY),
     row("tasks.task2_target_heading", HEADING, "rad", HEADING_WHY),
+    row("tasks.task2_spin", SPIN, "rad/s", SPIN_WHY),
+    row("tasks.task2_velocity", SPEED, "m/s", SPEED_WHY),
     row("tasks.task3_speed", SPEED, "m/s", SPEED_WHY),
     row("tasks.task3_distance", POSITION, "m", POSITION_WHY),
     row("tasks.task3_target_heading", HEADING, "rad", HEADING_WHY),

@@ -13,7 +13,7 @@ pub mod trial;
 
 pub use batch::BatchRunner;
 pub use body::{BodySettings, THRUSTER_COUNT};
-pub use fitness::{FitnessKind, FitnessSettings};
+pub use fitness::{FitnessKind, FitnessSettings, SlowingRule};
 pub use network_file::{NetworkFile, NetworkFileError};
 pub use sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
 pub use task::{Target, Task, TaskSettings};

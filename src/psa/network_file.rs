@@ -10,6 +10,7 @@
 //!   "activation": "logistic",
 //!   "input_scaling": { "position_scale": 10.0, ... },
 //!   "task": 1,
+//!   "problem": { the whole problem configuration: body, physics, sensors, tasks, fitness, noise, ... },
 //!   "neurons": [ { "weights": [11 numbers: 7 input weights (bias last), 4 output weights], "lesioned": false }, ... ],
 //!   "provenance": { "tool_version": "...", "git_commit": "...", "libode_version": "...", ... }
 //! }
@@ -22,6 +23,7 @@ use thiserror::Error;
 
 use super::sensors::SensorSettings;
 use super::task::Task;
+use super::trial::PsaSettings;
 use crate::network::Network;
 
 /// The `format` field of every network file.
@@ -80,6 +82,10 @@ pub struct NetworkFile {
     pub input_scaling: SensorSettings,
     /// The task it was evolved for.
     pub task: Task,
+    /// The whole problem configuration it was evolved under (body, physics,
+    /// sensors, tasks, fitness, noise); absent in files of older builds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub problem: Option<PsaSettings>,
     /// The hidden neurons.
     pub neurons: Vec<NeuronRecord>,
     /// Where it came from: the build, the time, and any further fields
@@ -94,7 +100,7 @@ impl NetworkFile {
     pub fn new(
         network: &Network,
         task: Task,
-        input_scaling: SensorSettings,
+        problem: &PsaSettings,
         extra: serde_json::Map<String, serde_json::Value>,
     ) -> NetworkFile {
         let build = crate::provenance::build_info();
@@ -112,8 +118,9 @@ impl NetworkFile {
                 outputs: network.outputs(),
             },
             activation: ACTIVATION.into(),
-            input_scaling,
+            input_scaling: problem.sensors,
             task,
+            problem: Some(problem.clone()),
             neurons: (0..network.hidden())
                 .map(|k| NeuronRecord {
                     weights: network.neuron(k).to_vec(),
@@ -184,6 +191,14 @@ impl NetworkFile {
                 "activation {:?} is not supported (only {ACTIVATION:?})",
                 file.activation
             )));
+        }
+        if let Some(problem) = &file.problem {
+            problem
+                .validate()
+                .map_err(|e| fail(format!("problem configuration: {e:#}")))?;
+            if problem.sensors != file.input_scaling {
+                return Err(fail("input_scaling differs from problem.sensors".into()));
+            }
         }
         let network = file.network().map_err(fail)?;
         Ok((file, network))

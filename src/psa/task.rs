@@ -90,11 +90,17 @@ pub struct TaskSettings {
     pub task1_spin: f64,
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
-    /// Task 3: initial forward (+y) speed (m/s). `[chosen]` 0.1
+    /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
+    /// turning when the trial starts. `[fitted]` 1.0 (docs/model.md)
+    pub task2_spin: f64,
+    /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
+    pub task2_velocity: [f64; 2],
+    /// Task 3: initial forward (+y) speed (m/s). `[fitted]` 0.3 (docs/model.md)
     pub task3_speed: f64,
     /// Task 3: distance of the target along +y (m). `[chosen]` 0.40
     pub task3_distance: f64,
-    /// Task 3: target heading (rad): turned round. `[chosen]` pi
+    /// Task 3: target heading (rad). `[fitted]` 0, the start heading: the
+    /// PSA turns round to brake and back again (docs/model.md)
     pub task3_target_heading: f64,
     /// Task 3, random initialisation: target distance range (m). `[paper]` [0.25, 0.55]
     pub task3_random_distance: [f64; 2],
@@ -105,9 +111,11 @@ impl Default for TaskSettings {
         TaskSettings {
             task1_spin: 1.0,
             task2_target_heading: FRAC_PI_2,
-            task3_speed: 0.1,
+            task2_spin: 1.0,
+            task2_velocity: [0.0, 0.0],
+            task3_speed: 0.3,
             task3_distance: 0.40,
-            task3_target_heading: PI,
+            task3_target_heading: 0.0,
             task3_random_distance: [0.25, 0.55],
         }
     }
@@ -121,6 +129,9 @@ impl TaskSettings {
         super::limits::check_all(&[
             ("tasks.task1_spin", self.task1_spin),
             ("tasks.task2_target_heading", self.task2_target_heading),
+            ("tasks.task2_spin", self.task2_spin),
+            ("tasks.task2_velocity", self.task2_velocity[0]),
+            ("tasks.task2_velocity", self.task2_velocity[1]),
             ("tasks.task3_speed", self.task3_speed),
             ("tasks.task3_distance", self.task3_distance),
             ("tasks.task3_target_heading", self.task3_target_heading),
@@ -158,7 +169,12 @@ impl TaskSettings {
                 )
             }
             Task::Turn => (
-                BodyState::default(),
+                BodyState {
+                    vx: self.task2_velocity[0],
+                    vy: self.task2_velocity[1],
+                    omega: self.task2_spin,
+                    ..BodyState::default()
+                },
                 Target {
                     heading: self.task2_target_heading,
                     ..Target::default()

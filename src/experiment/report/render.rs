@@ -2,6 +2,7 @@
 
 use std::fmt::Write as _;
 
+use super::distance::Distance;
 use super::findings::{Comparison, Finding, Rule, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
 use super::paper::PAPER_BURST_RUNS;
 use super::tables::{Report, Table};
@@ -9,7 +10,7 @@ use crate::experiment::grid::{GridPreset, GridSpec};
 use crate::experiment::PAPER_NOISE_SD;
 
 /// A mean or sd with one decimal; "–" when undefined.
-fn num(x: f64) -> String {
+pub(super) fn num(x: f64) -> String {
     if x.is_nan() {
         "–".into()
     } else {
@@ -59,9 +60,41 @@ pub fn markdown(report: &Report) -> String {
     for table in report.tables.iter().filter(|t| matches!(t.id.as_str(), "2" | "3")) {
         table_md(&mut md, table);
     }
+    distance_md(&mut md, &report.distance);
     findings_md(&mut md, report);
     figures_md(&mut md, report);
     md
+}
+
+/// The distance to the paper and its terms.
+pub(super) fn distance_md(md: &mut String, distance: &Distance) {
+    md.push_str(
+        "## Distance to the paper
+
+",
+    );
+    let _ = writeln!(
+        md,
+        "D = {:.1}: the sum of ((here - paper) / se)^2 over Table 1's task means, Table 2's means and the two burst totals, \
+         se being the paper's sd / sqrt(30) for a mean and sqrt(total) for a total (see docs/model.md).\n",
+        distance.total
+    );
+    md.push_str("| term | here | paper | se | z |\n|---|---|---|---|---|\n");
+    for t in &distance.terms {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {:+.1} |",
+            t.label,
+            num(t.here),
+            num(t.paper),
+            num(t.se),
+            t.z
+        );
+    }
+    if !distance.missing.is_empty() {
+        let _ = writeln!(md, "\nNot in D (no runs here): {}.", distance.missing.join(", "));
+    }
+    md.push('\n');
 }
 
 fn banners(md: &mut String, report: &Report) {

@@ -1,6 +1,7 @@
 //! The report's content: the grid, what is missing, the tables beside the
 //! paper's, the burst counts and the findings.
 
+use super::distance::Distance;
 use std::collections::BTreeMap;
 
 use serde::Serialize;
@@ -126,6 +127,8 @@ pub struct Report {
     pub bursts: Vec<BurstRow>,
     /// The paper's findings, judged here.
     pub findings: Vec<Finding>,
+    /// The distance to the paper (`docs/model.md`).
+    pub distance: Distance,
     /// The figures written.
     pub figures: Vec<FigureLink>,
     /// Figures that could not be drawn.
@@ -182,6 +185,7 @@ impl Report {
             tables,
             bursts: burst_rows(results),
             findings: findings(results),
+            distance: Distance::of(results),
             figures: Vec::new(),
             figure_problems: Vec::new(),
         }

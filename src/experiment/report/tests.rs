@@ -46,7 +46,7 @@ fn numbers(key: &RunKey) -> (f64, f64, Option<f64>, usize) {
 fn write_run(dir: &Path, spec: &GridSpec, key: &RunKey) -> PathBuf {
     let folder = run_dir(dir, key);
     std::fs::create_dir_all(&folder).unwrap();
-    let config = spec.run_config(key.config);
+    let config = spec.run_config(key.config).unwrap();
     std::fs::write(folder.join("config.toml"), config.to_toml().unwrap()).unwrap();
     let (champion, noise, random, bursts) = numbers(key);
     let mut csv = String::from("generation,min,mean,max,best,champion,evaluations,subpops,burst,bursts,lesion\n");
@@ -56,7 +56,7 @@ fn write_run(dir: &Path, spec: &GridSpec, key: &RunKey) -> PathBuf {
     }
     std::fs::write(folder.join("records.csv"), csv).unwrap();
     let network = Network::from_neurons(5, 4, &[vec![0.25; 9], vec![-0.5; 9]]).unwrap();
-    NetworkFile::new(&network, key.task, config.problem.sensors, serde_json::Map::new())
+    NetworkFile::new(&network, key.task, &config.problem, serde_json::Map::new())
         .save(&folder.join("champion.json"))
         .unwrap();
     let run = serde_json::json!({

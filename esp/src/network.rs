@@ -2,8 +2,8 @@
 //! units, stored neuron-wise as ESP needs it.
 //!
 //! Each hidden neuron owns `inputs` input weights (the bias input included)
-//! followed by `outputs` output weights: `inputs + outputs` genes (11 for the
-//! PSA's 7-H-4 network). Outputs are logistic too, with no separate bias.
+//! followed by `outputs` output weights: `inputs + outputs` genes (11 for a
+//! 7-H-4 network). Outputs are logistic too, with no separate bias.
 //! A lesioned hidden neuron contributes nothing to the outputs.
 
 use std::borrow::{Borrow, Cow};
@@ -29,10 +29,10 @@ pub enum NetworkError {
 }
 
 /// The logistic sigmoid 1 / (1 + e^-x), with our own `exp` (see
-/// [`crate::numeric`]) so that every path computes the same bits.
+/// [`crate::math`]) so that every path computes the same bits.
 #[inline]
 pub fn sigmoid(x: f64) -> f64 {
-    crate::numeric::sigmoid(x)
+    crate::math::sigmoid(x)
 }
 
 /// Whether every weight is finite: one pass without early exit, which the
@@ -198,9 +198,9 @@ impl Network {
 
     /// Computes the outputs for `input` into `output`; allocates nothing.
     ///
-    /// The order of operations is part of the definition (the batched path
-    /// in `psa::batch` repeats it lane by lane): each hidden unit starts at
-    /// `w[0] x[0]` and adds `w[1] x[1]`, `w[2] x[2]`, ... one fused
+    /// The order of operations is part of the definition (a batched
+    /// evaluator repeats it lane by lane with [`crate::math`]): each hidden
+    /// unit starts at `w[0] x[0]` and adds `w[1] x[1]`, `w[2] x[2]`, ... one fused
     /// multiply-add at a time; each output starts at 0 and adds the hidden
     /// units' contributions in neuron order, also fused.
     ///

@@ -1,17 +1,21 @@
-//! Search algorithms over networks: Enforced Sub-Populations (ESP) with every
-//! modification of Høverstad (2007) as a switch, and his hill-climber.
+//! Enforced Sub-Populations (ESP), the neuroevolution method of Gomez &
+//! Miikkulainen, with every modification of Høverstad, "Revisiting the
+//! Personal Satellite Assistant" (GECCO 2007), as a switch; and his
+//! parallel stochastic hill-climber.
 //!
-//! Both are generic: they search [`Network`](crate::network::Network)s against any [`Evaluator`] and
-//! know nothing of the PSA. Network evaluations run in parallel on rayon;
-//! every random draw comes from a stream keyed by what it is for (seed,
-//! generation, network, ...), so a run is bit-identical for any thread count.
+//! Both search [`Network`](network::Network)s (one hidden layer of
+//! logistic units, stored neuron by neuron as ESP needs it) against any
+//! [`Evaluator`]: a function that scores a network on your problem. Network
+//! evaluations run in parallel on rayon; every random draw comes from a
+//! counter-based stream ([`rng`]) keyed by what it is for (seed, generation,
+//! network, ...), so a run is bit-identical for any thread count.
 //!
 //! ```
-//! use psa_esp::evolution::{Esp, EspSettings, FnEvaluator};
-//! use psa_esp::network::Network;
+//! use esp_neuroevolution::network::Network;
+//! use esp_neuroevolution::{Esp, EspSettings, FnEvaluator};
 //!
 //! // Any control problem: here, make output 0 follow input 0 (a 2-H-1 network, bias last).
-//! let evaluator = FnEvaluator::new(2, 1, |net: &Network, _rng: &mut psa_esp::rng::Stream| {
+//! let evaluator = FnEvaluator::new(2, 1, |net: &Network, _rng: &mut esp_neuroevolution::rng::Stream| {
 //!     let mut out = [0.0];
 //!     let mut error = 0.0;
 //!     for x in [0.0, 0.25, 0.5, 0.75, 1.0] {
@@ -25,17 +29,26 @@
 //! assert!(result.champion.fitness > -0.05);
 //! ```
 
+mod error;
 mod esp;
 mod evaluator;
 mod hill_climb;
+pub mod math;
+pub mod network;
 pub mod operators;
 mod record;
+pub mod rng;
 mod subpop;
 
-pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, TopologyMode};
+pub use error::{RunError, SettingsError};
+pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, StagnationRule, TopologyMode};
 pub use evaluator::{evaluate_all, evaluate_each, Evaluator, FnEvaluator};
 pub use hill_climb::{HillClimb, HillClimbSettings, MutationRates};
-pub use record::{Champion, GenerationRecord, LesionOutcome, RunResult};
+pub use record::{Champion, Control, Ending, GenerationRecord, LesionOutcome, RunResult, StopAt};
+
+/// Records reserved at a run's start: at most its generations, which may
+/// be many more than a run that stops early needs.
+pub(crate) const RECORDS_RESERVED: usize = 4096;
 
 /// Keys of the random streams, one per purpose.
 pub(crate) mod purpose {
@@ -58,11 +71,11 @@ pub(crate) mod purpose {
 }
 
 /// Checks a probability setting.
-pub(crate) fn check_probability(name: &str, p: f64) -> Result<(), String> {
-    if (0.0..=1.0).contains(&p) {
+pub(crate) fn check_probability(name: &'static str, value: f64) -> Result<(), SettingsError> {
+    if (0.0..=1.0).contains(&value) {
         Ok(())
     } else {
-        Err(format!("{name} must be a probability in [0, 1], got {p}"))
+        Err(SettingsError::NotAProbability { name, value })
     }
 }
 
@@ -98,20 +111,28 @@ pub const MAX_NETWORKS_PER_GENERATION: usize = 100_000;
 pub const MIN_CAUCHY_LIMIT_PER_SCALE: f64 = 0.1;
 
 /// Checks a setting in (0, [`MAX_REAL_SETTING`]].
-pub(crate) fn check_positive(name: &str, v: f64) -> Result<(), String> {
-    if v > 0.0 && v <= MAX_REAL_SETTING {
-        Ok(())
+pub(crate) fn check_positive(name: &'static str, value: f64) -> Result<(), SettingsError> {
+    if !(value.is_finite() && value > 0.0) {
+        Err(SettingsError::NotPositive { name, value })
+    } else if value > MAX_REAL_SETTING {
+        Err(SettingsError::TooLarge {
+            name,
+            value,
+            max: MAX_REAL_SETTING,
+        })
     } else {
-        Err(format!("{name} must be in (0, {MAX_REAL_SETTING:e}], got {v:?}"))
+        Ok(())
     }
 }
 
 /// Checks a count setting in [min, max].
-pub(crate) fn check_count(name: &str, n: usize, min: usize, max: usize) -> Result<(), String> {
-    if (min..=max).contains(&n) {
-        Ok(())
+pub(crate) fn check_count(name: &'static str, value: usize, min: usize, max: usize) -> Result<(), SettingsError> {
+    if value < min {
+        Err(SettingsError::TooFew { name, value, min })
+    } else if value > max {
+        Err(SettingsError::TooMany { name, value, max })
     } else {
-        Err(format!("{name} must be in [{min}, {max}], got {n}"))
+        Ok(())
     }
 }
 
@@ -119,17 +140,21 @@ pub(crate) fn check_count(name: &str, n: usize, min: usize, max: usize) -> Resul
 /// [`MIN_CAUCHY_LIMIT_PER_SCALE`] times `largest_scale`, the largest Cauchy
 /// scale the run draws with (described by `scale_name`).
 pub(crate) fn check_cauchy_limit(
-    limit_name: &str,
+    limit_name: &'static str,
     limit: f64,
-    scale_name: &str,
+    scale_name: &'static str,
     largest_scale: f64,
-) -> Result<(), String> {
+) -> Result<(), SettingsError> {
     if limit >= MIN_CAUCHY_LIMIT_PER_SCALE * largest_scale {
         Ok(())
     } else {
-        Err(format!(
-            "{limit_name} = {limit:?} must be at least {MIN_CAUCHY_LIMIT_PER_SCALE} x {scale_name} = {largest_scale:e}, so that a Cauchy draw is accepted with probability >= 6 % (the draw is repeated until one is)"
-        ))
+        Err(SettingsError::CauchyLimitTooSmall {
+            limit_name,
+            limit,
+            scale_name,
+            scale: largest_scale,
+            ratio: MIN_CAUCHY_LIMIT_PER_SCALE,
+        })
     }
 }
 

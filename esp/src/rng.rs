@@ -69,8 +69,9 @@ impl StreamFamily {
 }
 
 /// Four well-mixed words from one (never all zero, as `mix` is a bijection
-/// of four distinct inputs): the seed of a 256-bit generator.
-pub(crate) fn expand(seed: u64) -> [u64; 4] {
+/// of four distinct inputs): the seed of a 256-bit generator, such as
+/// the state of a noise generator keyed like the streams.
+pub fn expand(seed: u64) -> [u64; 4] {
     [0, 1, 2, 3].map(|i| mix(seed.wrapping_add(i)))
 }
 

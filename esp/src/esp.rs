@@ -3,7 +3,6 @@
 
 use std::borrow::Cow;
 
-use anyhow::{anyhow, bail, Result};
 use rand::seq::SliceRandom;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
@@ -12,9 +11,11 @@ use super::operators::{cauchy, crossover, mutate_one_gene};
 use super::subpop::Subpop;
 use super::{
     best_of, check_cauchy_limit, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
-    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_SUBPOP_SIZE, MAX_TRIALS_PER_NEURON,
+    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_SUBPOP_SIZE, MAX_TRIALS_PER_NEURON, RECORDS_RESERVED,
 };
-use super::{Champion, Evaluator, GenerationRecord, LesionOutcome, RunResult};
+use super::{
+    Champion, Control, Ending, Evaluator, GenerationRecord, LesionOutcome, RunError, RunResult, SettingsError, StopAt,
+};
 use crate::network::{Network, NetworkSet};
 use crate::rng::stream;
 
@@ -53,6 +54,23 @@ pub enum BurstMode {
     Gomez,
 }
 
+/// When the search has stagnated (`algorithms.md` §1; the paper's §3.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StagnationRule {
+    /// The paper's and Gomez's code's reading: the best network fitness of
+    /// each generation is logged since the last burst mutation (the phase
+    /// best, reset at every burst and topology change); stagnation is
+    /// declared when it has not risen for `stagnation` generations. After a
+    /// burst the population climbs back, and each rise postpones the next
+    /// burst. `[paper]`
+    PhaseBest,
+    /// Generations since the search's best network (all-time) last
+    /// improved: after a fruitless burst the next one follows exactly
+    /// `stagnation` generations later. (This tool's first reading.)
+    AllTimeBest,
+}
+
 /// Whether lesion tests change the topology.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -63,7 +81,10 @@ pub enum TopologyMode {
     Off,
 }
 
-/// Every setting of ESP; defaults are the paper's baseline (Table 1).
+/// Every setting of ESP. The default is Gomez's ESP ([`EspSettings::gomez`]);
+/// each field's doc ends with its value in Høverstad's modified ESP
+/// ([`EspSettings::hoverstad`]), tagged `[paper]` (the ESP papers and code,
+/// or Høverstad's) or `[chosen]` (chosen here).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EspSettings {
@@ -87,8 +108,12 @@ pub struct EspSettings {
     pub mutation_scale: f64,
     /// Cauchy draws larger than this in magnitude are drawn again. `[paper]` 10
     pub cauchy_limit: f64,
-    /// Generations without improvement of the best network before a burst mutation (b). `[paper]` 20
+    /// Generations without improvement before a burst mutation (b).
+    /// Gomez's code: 20 (the default); Høverstad gives no number (the PSA's
+    /// fitted value is 40: psa-esp's docs/model.md)
     pub stagnation: usize,
+    /// What "without improvement" means. Gomez's code and Høverstad's §3.2: phase_best
+    pub stagnation_rule: StagnationRule,
     /// Scale of the Cauchy noise of burst mutation, on every gene. `[paper]` 0.3
     pub burst_scale: f64,
     /// Burst mutation's form. `[paper, Høverstad]` discard_all
@@ -104,7 +129,34 @@ pub struct EspSettings {
 }
 
 impl Default for EspSettings {
+    /// [`EspSettings::gomez`].
     fn default() -> Self {
+        EspSettings::gomez()
+    }
+}
+
+impl EspSettings {
+    /// Gomez's ESP as his code defines it: burst mutation rebuilds the best
+    /// network's sub-populations and keeps any added since
+    /// ([`BurstMode::Gomez`]), one fruitless burst mutation brings a lesion
+    /// test, and a neuron is redundant when the network keeps 80 % of its
+    /// fitness without it. The population's shape (40 neurons per
+    /// sub-population, 10 networks per neuron, 5 hidden neurons at first,
+    /// initial weights in (-6, 6)) and the 2000 generations are common
+    /// settings to change for a problem.
+    pub fn gomez() -> EspSettings {
+        EspSettings {
+            burst: BurstMode::Gomez,
+            bursts_before_lesion: 1,
+            lesion_threshold: 0.8,
+            ..EspSettings::hoverstad()
+        }
+    }
+
+    /// Høverstad's modified ESP (his Table 1): burst mutation discards all
+    /// sub-populations ([`BurstMode::DiscardAll`]), two fruitless burst
+    /// mutations bring a lesion test, and the lesion threshold is 0.9.
+    pub fn hoverstad() -> EspSettings {
         EspSettings {
             subpop_size: 40,
             trials_per_neuron: 10,
@@ -117,6 +169,7 @@ impl Default for EspSettings {
             mutation_scale: 0.3,
             cauchy_limit: 10.0,
             stagnation: 20,
+            stagnation_rule: StagnationRule::PhaseBest,
             burst_scale: 0.3,
             burst: BurstMode::DiscardAll,
             topology: TopologyMode::Lesion,
@@ -125,11 +178,9 @@ impl Default for EspSettings {
             erase_best: false,
         }
     }
-}
 
-impl EspSettings {
     /// Rejects out-of-range values, naming the setting.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         check_count("esp.subpop_size", self.subpop_size, 4, MAX_SUBPOP_SIZE)?;
         check_count(
             "esp.trials_per_neuron",
@@ -149,10 +200,11 @@ impl EspSettings {
         check_probability("esp.lesion_threshold", self.lesion_threshold)?;
         let networks = self.networks_per_generation();
         if networks > MAX_NETWORKS_PER_GENERATION {
-            return Err(format!(
-                "esp.trials_per_neuron x esp.subpop_size = {} x {} = {networks} networks per generation, more than {MAX_NETWORKS_PER_GENERATION}",
-                self.trials_per_neuron, self.subpop_size
-            ));
+            return Err(SettingsError::TooManyNetworks {
+                trials_per_neuron: self.trials_per_neuron,
+                subpop_size: self.subpop_size,
+                max: MAX_NETWORKS_PER_GENERATION,
+            });
         }
         let (scale_name, scale) = if self.mutation_scale >= self.burst_scale {
             ("esp.mutation_scale", self.mutation_scale)
@@ -168,11 +220,12 @@ impl EspSettings {
     }
 }
 
-/// An ESP run: settings and seed.
+/// An ESP run: settings, seed and when to stop early.
 #[derive(Debug, Clone)]
 pub struct Esp {
     settings: EspSettings,
     seed: u64,
+    stop: StopAt,
 }
 
 /// The search's state between generations.
@@ -184,7 +237,11 @@ struct State {
     /// The search's best network and its fitness (what burst mutation builds on).
     best: Option<(Network, f64)>,
     champion: Option<Champion>,
+    /// Generations without improvement, as the stagnation rule counts them.
     since_improvement: usize,
+    /// The best network fitness since the phase began (the last burst
+    /// mutation or topology change; the run's start).
+    phase_best: f64,
     bursts_since_improvement: usize,
     /// Discard-all: the topology change to apply again after each burst.
     pending: Option<LesionOutcome>,
@@ -202,6 +259,7 @@ impl State {
             best: None,
             champion: None,
             since_improvement: 0,
+            phase_best: f64::NEG_INFINITY,
             bursts_since_improvement: 0,
             pending: None,
             bursts: 0,
@@ -212,15 +270,16 @@ impl State {
     /// The networks `picks` form (pick[i]: the neuron taken from
     /// sub-population i), read in place from the sub-populations; fails
     /// if any weight of any sub-population is not finite.
-    fn networks<'a>(&'a self, picks: &'a Picks) -> Result<Assembled<'a>> {
+    fn networks<'a>(&'a self, picks: &'a Picks) -> Result<Assembled<'a>, RunError> {
         // Checked here once, so that the networks' neurons need no check.
         for (i, subpop) in self.subpops.iter().enumerate() {
             if let Some((k, gene)) = subpop.first_non_finite() {
-                bail!(
-                    "weight {gene} of neuron {k} of sub-population {i} is not finite ({}): \
-                     the mutation and burst settings let the weights overflow",
-                    subpop.neuron(k)[gene]
-                );
+                return Err(RunError::NonFiniteWeight {
+                    subpop: i,
+                    neuron: k,
+                    gene,
+                    value: subpop.neuron(k)[gene],
+                });
             }
         }
         Ok(Assembled {
@@ -291,9 +350,18 @@ impl Picks {
 
 impl Esp {
     /// An ESP run with `settings` and `seed`; fails on invalid settings.
-    pub fn new(settings: EspSettings, seed: u64) -> Result<Esp, String> {
+    pub fn new(settings: EspSettings, seed: u64) -> Result<Esp, SettingsError> {
         settings.validate()?;
-        Ok(Esp { settings, seed })
+        Ok(Esp {
+            settings,
+            seed,
+            stop: StopAt::NEVER,
+        })
+    }
+
+    /// This run, ending early when `stop` says so.
+    pub fn stop_at(self, stop: StopAt) -> Esp {
+        Esp { stop, ..self }
     }
 
     /// The settings.
@@ -301,13 +369,15 @@ impl Esp {
         &self.settings
     }
 
-    /// Runs all generations on the current rayon pool, calling
-    /// `on_generation` after each.
-    pub fn run<E: Evaluator>(
+    /// Runs the generations on the current rayon pool, calling
+    /// `on_generation` after each, until the last, or until the stop
+    /// conditions ([`Esp::stop_at`]) or `on_generation` (returning
+    /// [`Control::Stop`]) end the run.
+    pub fn run<E: Evaluator, C: Into<Control>>(
         &self,
         evaluator: &E,
-        mut on_generation: impl FnMut(&GenerationRecord),
-    ) -> Result<RunResult> {
+        mut on_generation: impl FnMut(&GenerationRecord) -> C,
+    ) -> Result<RunResult, RunError> {
         let s = &self.settings;
         let (inputs, outputs) = (evaluator.inputs(), evaluator.outputs());
         let genes = inputs + outputs;
@@ -316,14 +386,23 @@ impl Esp {
             .map(|_| Subpop::random(&mut rng, s.subpop_size, genes, s.init_range))
             .collect();
         let mut state = State::new(inputs, outputs, subpops);
-        let mut records = Vec::with_capacity(s.generations);
+        let mut records = Vec::with_capacity(s.generations.min(RECORDS_RESERVED));
+        let mut ending = Ending::Completed;
         for generation in 1..=s.generations {
             let record = self.generation(evaluator, &mut state, generation)?;
-            on_generation(&record);
+            let decision = self.stop.decide(&record, on_generation(&record).into());
             records.push(record);
+            if let Some(end) = decision {
+                ending = end;
+                break;
+            }
         }
-        let champion = state.champion.ok_or_else(|| anyhow!("no network was evaluated"))?;
-        Ok(RunResult { champion, records })
+        let champion = state.champion.expect("every generation has a champion");
+        Ok(RunResult {
+            champion,
+            records,
+            ending,
+        })
     }
 
     /// Which neuron of each sub-population every network takes.
@@ -359,27 +438,35 @@ impl Esp {
         evaluator: &E,
         state: &mut State,
         generation: usize,
-    ) -> Result<GenerationRecord> {
+    ) -> Result<GenerationRecord, RunError> {
         let picks = self.sample(generation, state.subpops.len());
         let networks = state.networks(&picks)?;
         let fitness = evaluate_all(evaluator, &networks, self.seed, &[purpose::EVALUATE, generation as u64])?;
         let (top, top_fitness) = best_of(&fitness);
+        let top_evaluation = state.evaluations + top as u64 + 1;
         let top = networks.network(top).into_owned();
-        self.conclude(evaluator, state, &picks, fitness, (top, top_fitness), generation)
+        self.conclude(
+            evaluator,
+            state,
+            &picks,
+            fitness,
+            (top, top_fitness, top_evaluation),
+            generation,
+        )
     }
 
-    /// The generation after its evaluation, given its best network and
-    /// that network's fitness: champion and best, then burst mutation or
-    /// credit and recombination; returns its record.
+    /// The generation after its evaluation, given its best network, that
+    /// network's fitness and evaluation number: champion and best, then
+    /// burst mutation or credit and recombination; returns its record.
     fn conclude<E: Evaluator>(
         &self,
         evaluator: &E,
         state: &mut State,
         picks: &Picks,
         fitness: Vec<f64>,
-        (top, top_fitness): (Network, f64),
+        (top, top_fitness, top_evaluation): (Network, f64, u64),
         generation: usize,
-    ) -> Result<GenerationRecord> {
+    ) -> Result<GenerationRecord, RunError> {
         let s = &self.settings;
         state.evaluations += picks.count() as u64;
 
@@ -389,14 +476,22 @@ impl Esp {
                 network: top.clone(),
                 fitness: top_fitness,
                 generation,
+                evaluation: top_evaluation,
             });
         }
         let improved = state.best.as_ref().is_none_or(|(_, f)| top_fitness > *f);
         if improved {
             state.best = Some((top, top_fitness));
-            state.since_improvement = 0;
             state.bursts_since_improvement = 0;
             state.pending = None;
+        }
+        let progressed = match s.stagnation_rule {
+            StagnationRule::AllTimeBest => improved,
+            StagnationRule::PhaseBest => top_fitness > state.phase_best,
+        };
+        state.phase_best = state.phase_best.max(top_fitness);
+        if progressed {
+            state.since_improvement = 0;
         } else {
             state.since_improvement += 1;
         }
@@ -405,6 +500,7 @@ impl Esp {
         let mut lesion = None;
         if state.since_improvement >= s.stagnation {
             state.since_improvement = 0;
+            state.phase_best = f64::NEG_INFINITY;
             burst = true;
             lesion = self.stagnate(evaluator, state, generation)?;
         } else {
@@ -498,7 +594,7 @@ impl Esp {
         evaluator: &E,
         state: &mut State,
         generation: usize,
-    ) -> Result<Option<LesionOutcome>> {
+    ) -> Result<Option<LesionOutcome>, RunError> {
         let s = &self.settings;
         let lesion_on = s.topology == TopologyMode::Lesion;
         let mut outcome = None;
@@ -509,7 +605,7 @@ impl Esp {
         let (best, _) = state
             .best
             .clone()
-            .ok_or_else(|| anyhow!("burst mutation without a best network"))?;
+            .expect("the search has a best network when it stagnates");
         let mut rng = stream(self.seed, &[purpose::BURST, generation as u64]);
         match s.burst {
             BurstMode::Gomez => {
@@ -558,11 +654,16 @@ impl Esp {
     /// Evaluates the best network whole and with each hidden neuron
     /// lesioned: a neuron is redundant when the network keeps
     /// `lesion_threshold` of its fitness without it.
-    fn lesion_test<E: Evaluator>(&self, evaluator: &E, state: &mut State, generation: usize) -> Result<LesionOutcome> {
+    fn lesion_test<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        generation: usize,
+    ) -> Result<LesionOutcome, RunError> {
         let (best, _) = state
             .best
             .as_ref()
-            .ok_or_else(|| anyhow!("lesion test without a best network"))?;
+            .expect("the search has a best network when it stagnates");
         let mut variants = vec![best.clone()];
         for k in 0..best.hidden() {
             let mut lesioned = best.clone();
@@ -619,7 +720,7 @@ impl Esp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evolution::FnEvaluator;
+    use crate::FnEvaluator;
 
     fn esp(settings: EspSettings) -> Esp {
         Esp::new(settings, 11).unwrap()
@@ -639,7 +740,7 @@ mod tests {
         let e = esp(EspSettings {
             subpop_size: 12,
             mutation_rate: 0.0,
-            ..EspSettings::default()
+            ..EspSettings::hoverstad()
         });
         // Neuron k's genes all equal k: a child's genes show its parents.
         let mut subpop = Subpop::from_neurons(5, (0..12).map(|k| [k as f64; 5]));
@@ -669,7 +770,7 @@ mod tests {
         let e = esp(EspSettings {
             subpop_size: 40,
             mutation_rate: 0.4,
-            ..EspSettings::default()
+            ..EspSettings::hoverstad()
         });
         let mut mutated = 0;
         for generation in 0..200 {
@@ -691,7 +792,7 @@ mod tests {
     fn systematic_sampling_evaluates_every_neuron_exactly_ten_times() {
         let e = esp(EspSettings {
             sampling: Sampling::Systematic,
-            ..EspSettings::default()
+            ..EspSettings::hoverstad()
         });
         let picks = e.sample(3, 5);
         assert_eq!(picks.count(), 400);
@@ -701,7 +802,7 @@ mod tests {
             assert!(counts.iter().all(|&c| c == 10), "sub-population {i}: {counts:?}");
         }
         // Random sampling: 400 picks per sub-population, unevenly spread.
-        let random = esp(EspSettings::default()).sample(3, 5);
+        let random = esp(EspSettings::hoverstad()).sample(3, 5);
         let mut counts = [0; 40];
         random.networks().for_each(|p| counts[p[0]] += 1);
         assert_eq!(counts.iter().sum::<usize>(), 400);
@@ -714,7 +815,7 @@ mod tests {
             let e = esp(EspSettings {
                 subpop_size: 4,
                 credit,
-                ..EspSettings::default()
+                ..EspSettings::hoverstad()
             });
             let mut st = state(&e, 1);
             st.subpops[0] = Subpop::from_neurons(3, (0..4).map(|k| [k as f64; 3]));
@@ -735,7 +836,7 @@ mod tests {
     fn assembly_reads_the_picked_neurons_and_refuses_a_non_finite_weight() {
         let e = esp(EspSettings {
             subpop_size: 4,
-            ..EspSettings::default()
+            ..EspSettings::hoverstad()
         });
         let mut st = state(&e, 2);
         let picks = Picks {
@@ -777,7 +878,7 @@ mod tests {
     fn burst_mutation_rebuilds_every_subpop_around_the_best_network() {
         let e = esp(EspSettings {
             topology: TopologyMode::Off,
-            ..EspSettings::default()
+            ..EspSettings::hoverstad()
         });
         let mut st = state(&e, 3);
         let best =
@@ -816,7 +917,7 @@ mod tests {
 
     #[test]
     fn lesion_test_removes_a_redundant_neuron_and_adds_otherwise() {
-        let e = esp(EspSettings::default());
+        let e = esp(EspSettings::hoverstad());
         let mut st = state(&e, 3);
         // Neuron 1 contributes 1 % of the fitness: redundant.
         let net =
@@ -863,7 +964,7 @@ mod tests {
 
     #[test]
     fn discard_all_keeps_the_subpop_count_within_best_plus_or_minus_one() {
-        let states = run_states(EspSettings::default(), 120);
+        let states = run_states(EspSettings::hoverstad(), 120);
         assert!(
             states.iter().filter(|s| s.2.is_some()).count() >= 5,
             "lesion tests happened"
@@ -880,7 +981,7 @@ mod tests {
         let gomez = run_states(
             EspSettings {
                 burst: BurstMode::Gomez,
-                ..EspSettings::default()
+                ..EspSettings::hoverstad()
             },
             120,
         );
@@ -895,7 +996,7 @@ mod tests {
             trials_per_neuron: 2,
             stagnation: 3,
             erase_best: true,
-            ..EspSettings::default()
+            ..EspSettings::hoverstad()
         });
         let mut st = state(&e, 5);
         let eval = all_neurons_needed();
@@ -914,5 +1015,161 @@ mod tests {
             }
         }
         assert!(saw_erase);
+    }
+
+    #[test]
+    fn a_run_stops_where_the_goal_the_budget_or_the_callback_says_and_returns_its_result() {
+        let settings = EspSettings {
+            subpop_size: 8,
+            trials_per_neuron: 2,
+            generations: 40,
+            ..EspSettings::hoverstad()
+        };
+        let eval = redundancy_evaluator();
+        let run = |stop: StopAt, stop_after: usize| {
+            Esp::new(settings.clone(), 3)
+                .unwrap()
+                .stop_at(stop)
+                .run(&eval, |r| {
+                    if r.generation == stop_after {
+                        Control::Stop
+                    } else {
+                        Control::Continue
+                    }
+                })
+                .unwrap()
+        };
+        let whole = run(StopAt::NEVER, 0);
+        assert_eq!((whole.ending, whole.records.len()), (Ending::Completed, 40));
+        let prefix = |result: &RunResult| {
+            assert_eq!(
+                result.records[..],
+                whole.records[..result.records.len()],
+                "the same run, cut short"
+            );
+        };
+        let goal = whole.records[9].champion;
+        let reached = run(
+            StopAt {
+                goal: Some(goal),
+                ..StopAt::NEVER
+            },
+            0,
+        );
+        prefix(&reached);
+        assert_eq!(reached.ending, Ending::Goal);
+        assert_eq!(reached.records.last().unwrap().champion, goal);
+        assert!(reached.records.len() <= 10);
+        // The champion's evaluation number: 16 networks a generation, plus lesion tests.
+        let champion = &reached.champion;
+        let before = match champion.generation {
+            1 => 0,
+            g => reached.records[g - 2].evaluations,
+        };
+        assert!(champion.evaluation > before && champion.evaluation <= before + 16);
+        let budget = run(
+            StopAt {
+                evaluations: Some(100),
+                ..StopAt::NEVER
+            },
+            0,
+        );
+        prefix(&budget);
+        assert_eq!(budget.ending, Ending::Budget);
+        let spent = budget.evaluations();
+        assert!(
+            spent >= 100 && budget.records[budget.records.len() - 2].evaluations < 100,
+            "{spent}"
+        );
+        let told = run(StopAt::NEVER, 7);
+        prefix(&told);
+        assert_eq!((told.ending, told.records.len()), (Ending::Stopped, 7));
+    }
+
+    #[test]
+    fn gomez_and_hoverstad_differ_in_burst_mode_lesion_timing_and_threshold_only() {
+        let (g, h) = (EspSettings::gomez(), EspSettings::hoverstad());
+        assert_eq!(EspSettings::default(), g);
+        assert_eq!(
+            (g.burst, g.bursts_before_lesion, g.lesion_threshold),
+            (BurstMode::Gomez, 1, 0.8)
+        );
+        assert_eq!(
+            (h.burst, h.bursts_before_lesion, h.lesion_threshold),
+            (BurstMode::DiscardAll, 2, 0.9)
+        );
+        assert_eq!(
+            EspSettings {
+                burst: h.burst,
+                bursts_before_lesion: h.bursts_before_lesion,
+                lesion_threshold: h.lesion_threshold,
+                ..g
+            },
+            h
+        );
+        let err = Esp::new(
+            EspSettings {
+                mutation_rate: 1.5,
+                ..g
+            },
+            1,
+        )
+        .unwrap_err();
+        assert_eq!(
+            err,
+            SettingsError::NotAProbability {
+                name: "esp.mutation_rate",
+                value: 1.5
+            }
+        );
+        assert_eq!(
+            err.to_string(),
+            "esp.mutation_rate must be a probability in [0, 1], got 1.5"
+        );
+    }
+
+    /// Feeds `tops` to `conclude` as the generations' best fitnesses (no
+    /// lesion tests) and returns the generations that burst.
+    fn bursts_for(rule: StagnationRule, tops: &[f64]) -> Vec<usize> {
+        let e = esp(EspSettings {
+            subpop_size: 8,
+            trials_per_neuron: 2,
+            stagnation: 3,
+            stagnation_rule: rule,
+            topology: TopologyMode::Off,
+            ..EspSettings::default()
+        });
+        let mut st = state(&e, 2);
+        let eval = all_neurons_needed();
+        let mut bursts = Vec::new();
+        for (g, &top) in tops.iter().enumerate() {
+            let generation = g + 1;
+            let picks = e.sample(generation, st.subpops.len());
+            let network = st.networks(&picks).unwrap().network(0).into_owned();
+            let fitness = vec![top; picks.count()];
+            let record = e
+                .conclude(&eval, &mut st, &picks, fitness, (network, top, 1), generation)
+                .unwrap();
+            if record.burst {
+                bursts.push(generation);
+            }
+        }
+        bursts
+    }
+
+    #[test]
+    fn stagnation_follows_the_phase_best_or_the_all_time_best() {
+        // The best of generation 1 stands; the burst at 4 sets the
+        // population back, which climbs again during 5-7 without reaching 5.
+        let tops = [5.0, 5.0, 5.0, 5.0, 1.0, 2.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0];
+        // Phase best: each rise postpones the burst; stagnation is 3
+        // generations after the phase best last rose.
+        assert_eq!(bursts_for(StagnationRule::PhaseBest, &tops), [4, 10]);
+        // All-time best: a fruitless burst is followed by the next exactly 3 later.
+        assert_eq!(bursts_for(StagnationRule::AllTimeBest, &tops), [4, 7, 10, 13]);
+        // A new all-time best restarts both counts.
+        let rising = [1.0, 2.0, 3.0, 3.0, 3.0, 3.0, 4.0, 4.0, 4.0, 4.0];
+        assert_eq!(bursts_for(StagnationRule::PhaseBest, &rising), [6, 10]);
+        assert_eq!(bursts_for(StagnationRule::AllTimeBest, &rising), [6, 10]);
     }
 }

@@ -1,6 +1,5 @@
 //! Høverstad's parallel stochastic hill-climber (`algorithms.md` §3).
 
-use anyhow::{anyhow, Result};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
@@ -9,7 +8,10 @@ use super::{
     best_of, check_cauchy_limit, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
     MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION,
 };
-use super::{Champion, Evaluator, GenerationRecord, RunResult};
+use super::{
+    Champion, Control, Ending, Evaluator, GenerationRecord, RunError, RunResult, SettingsError, StopAt,
+    RECORDS_RESERVED,
+};
 use crate::network::Network;
 use crate::rng::{stream, Stream};
 
@@ -64,7 +66,7 @@ impl Default for HillClimbSettings {
 
 impl HillClimbSettings {
     /// Rejects out-of-range values, naming the setting.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SettingsError> {
         check_count("hill_climb.hidden", self.hidden, 1, MAX_HIDDEN)?;
         check_count("hill_climb.candidates", self.candidates, 1, MAX_NETWORKS_PER_GENERATION)?;
         check_count("hill_climb.cycles", self.cycles, 1, MAX_GENERATIONS)?;
@@ -103,18 +105,28 @@ pub struct MutationRates {
     pub p_flip: f64,
 }
 
-/// A hill-climbing run: settings and seed.
+/// A hill-climbing run: settings, seed and when to stop early.
 #[derive(Debug, Clone)]
 pub struct HillClimb {
     settings: HillClimbSettings,
     seed: u64,
+    stop: StopAt,
 }
 
 impl HillClimb {
     /// A run with `settings` and `seed`; fails on invalid settings.
-    pub fn new(settings: HillClimbSettings, seed: u64) -> Result<HillClimb, String> {
+    pub fn new(settings: HillClimbSettings, seed: u64) -> Result<HillClimb, SettingsError> {
         settings.validate()?;
-        Ok(HillClimb { settings, seed })
+        Ok(HillClimb {
+            settings,
+            seed,
+            stop: StopAt::NEVER,
+        })
+    }
+
+    /// This run, ending early when `stop` says so.
+    pub fn stop_at(self, stop: StopAt) -> HillClimb {
+        HillClimb { stop, ..self }
     }
 
     /// The rates of cycle `cycle` (from 1): each initial rate times its
@@ -142,8 +154,15 @@ impl HillClimb {
         }
     }
 
-    /// Runs all cycles on the current rayon pool, calling `on_cycle` after each.
-    pub fn run<E: Evaluator>(&self, evaluator: &E, mut on_cycle: impl FnMut(&GenerationRecord)) -> Result<RunResult> {
+    /// Runs the cycles on the current rayon pool, calling `on_cycle` after
+    /// each, until the last, or until the stop conditions
+    /// ([`HillClimb::stop_at`]) or `on_cycle` (returning [`Control::Stop`])
+    /// end the run.
+    pub fn run<E: Evaluator, C: Into<Control>>(
+        &self,
+        evaluator: &E,
+        mut on_cycle: impl FnMut(&GenerationRecord) -> C,
+    ) -> Result<RunResult, RunError> {
         let s = &self.settings;
         let (inputs, outputs) = (evaluator.inputs(), evaluator.outputs());
         let mut rng = stream(self.seed, &[purpose::INIT]);
@@ -166,7 +185,8 @@ impl HillClimb {
             f64::NEG_INFINITY
         };
         let mut champion: Option<Champion> = None;
-        let mut records = Vec::with_capacity(s.cycles);
+        let mut records = Vec::with_capacity(s.cycles.min(RECORDS_RESERVED));
+        let mut ending = Ending::Completed;
         for cycle in 1..=s.cycles {
             let rates = self.rates(cycle);
             let candidates = (0..s.candidates)
@@ -186,15 +206,16 @@ impl HillClimb {
                 self.seed,
                 &[purpose::EVALUATE, cycle as u64],
             )?;
-            evaluations += candidates.len() as u64;
             let (top, top_fitness) = best_of(&fitness);
             if champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
                 champion = Some(Champion {
                     network: candidates[top].clone(),
                     fitness: top_fitness,
                     generation: cycle,
+                    evaluation: evaluations + top as u64 + 1,
                 });
             }
+            evaluations += candidates.len() as u64;
             if !s.elitist || top_fitness >= base_fitness {
                 base = candidates[top].clone();
                 base_fitness = top_fitness;
@@ -213,18 +234,26 @@ impl HillClimb {
                 bursts: 0,
                 lesion: None,
             };
-            on_cycle(&record);
+            let decision = self.stop.decide(&record, on_cycle(&record).into());
             records.push(record);
+            if let Some(end) = decision {
+                ending = end;
+                break;
+            }
         }
-        let champion = champion.ok_or_else(|| anyhow!("no network was evaluated"))?;
-        Ok(RunResult { champion, records })
+        let champion = champion.expect("every cycle has a champion");
+        Ok(RunResult {
+            champion,
+            records,
+            ending,
+        })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evolution::FnEvaluator;
+    use crate::FnEvaluator;
 
     #[test]
     fn noise_and_sign_flips_happen_at_the_configured_rates() {
@@ -319,5 +348,54 @@ mod tests {
         // The champion is the best network ever evaluated.
         let top = plain.records.iter().map(|r| r.max).fold(f64::NEG_INFINITY, f64::max);
         assert_eq!(plain.champion.fitness, top);
+    }
+
+    #[test]
+    fn a_run_stops_at_its_goal_or_budget_and_counts_the_champions_evaluation() {
+        let noise = FnEvaluator::new(2, 1, |_: &Network, rng: &mut Stream| Ok(rng.random::<f64>()));
+        let settings = HillClimbSettings {
+            candidates: 7,
+            cycles: 50,
+            elitist: true,
+            ..HillClimbSettings::default()
+        };
+        let whole = HillClimb::new(settings.clone(), 4)
+            .unwrap()
+            .run(&noise, |_| {})
+            .unwrap();
+        assert_eq!((whole.ending, whole.evaluations()), (Ending::Completed, 1 + 50 * 7));
+        let goal = whole.records[20].champion;
+        let stopped = HillClimb::new(settings.clone(), 4)
+            .unwrap()
+            .stop_at(StopAt {
+                goal: Some(goal),
+                ..StopAt::NEVER
+            })
+            .run(&noise, |_| {})
+            .unwrap();
+        let first = whole.records.iter().position(|r| r.champion >= goal).unwrap();
+        assert_eq!(stopped.ending, Ending::Goal);
+        assert_eq!(
+            stopped.records[..],
+            whole.records[..=first],
+            "the same run up to the goal"
+        );
+        let champion = &stopped.champion;
+        // The elitist base's evaluation comes first, then 7 per cycle.
+        assert!(champion.evaluation > 1 + 7 * (champion.generation as u64 - 1));
+        assert!(champion.evaluation <= 1 + 7 * champion.generation as u64);
+        let budget = HillClimb::new(settings, 4)
+            .unwrap()
+            .stop_at(StopAt {
+                evaluations: Some(100),
+                ..StopAt::NEVER
+            })
+            .run(&noise, |_| {})
+            .unwrap();
+        // 1 + 7 x 15 = 106 is the first count of at least 100.
+        assert_eq!(
+            (budget.ending, budget.records.len(), budget.evaluations()),
+            (Ending::Budget, 15, 106)
+        );
     }
 }

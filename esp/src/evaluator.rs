@@ -1,0 +1,394 @@
+//! What the algorithms search against: anything that scores a network.
+
+use std::ops::Range;
+
+use anyhow::{anyhow, Result};
+
+use crate::RunError;
+use rayon::prelude::*;
+
+use crate::network::{Network, NetworkSet};
+use crate::rng::{Stream, StreamFamily};
+
+/// Scores networks. `Worker` is per-thread state (for a physics
+/// simulation, its world, which may have to stay on the thread that made
+/// it); the algorithms make one per parallel task and never move it
+/// between threads.
+pub trait Evaluator: Sync {
+    /// Per-thread evaluation state.
+    type Worker;
+    /// Network inputs (bias included).
+    fn inputs(&self) -> usize;
+    /// Network outputs.
+    fn outputs(&self) -> usize;
+    /// Makes the per-thread state.
+    fn worker(&self) -> Result<Self::Worker>;
+    /// The fitness of `network`; all randomness must come from `rng`, so that
+    /// the same network and stream give the same fitness. Higher is better.
+    fn evaluate(&self, worker: &mut Self::Worker, network: &Network, rng: &mut Stream) -> Result<f64>;
+
+    /// How many networks [`Evaluator::evaluate_batch`] takes at a time to
+    /// best effect; 1 (the default) means no batching.
+    fn batch_size(&self) -> usize {
+        1
+    }
+
+    /// The fewest networks worth a batch of their own, at most
+    /// [`Evaluator::batch_size`]: a batch of fewer takes at least as long as
+    /// one of this many, so the networks left after the full batches are
+    /// not cut into smaller pieces for the threads to share (see
+    /// [`evaluate_all`]). 1 (the default) lets them be cut as fine as the
+    /// thread count asks.
+    fn narrowest_batch(&self) -> usize {
+        1
+    }
+
+    /// The fitness of networks `range` of `networks`, network `j` with the
+    /// stream `streams.stream(j)`: what [`Evaluator::evaluate`] gives each,
+    /// bit for bit. The default calls it network by network; a batched
+    /// evaluator evaluates them in lockstep, reading their weights in place.
+    /// Making the streams is part of the evaluation: an evaluator that
+    /// draws nothing need not make them.
+    fn evaluate_batch<S: NetworkSet + ?Sized>(
+        &self,
+        worker: &mut Self::Worker,
+        networks: &S,
+        range: Range<usize>,
+        streams: &StreamFamily,
+    ) -> Result<Vec<f64>> {
+        evaluate_each(self, worker, networks, range, streams)
+    }
+}
+
+/// [`Evaluator::evaluate_batch`] network by network, through
+/// [`Evaluator::evaluate`]: the default, and what a batched evaluator falls
+/// back on.
+pub fn evaluate_each<E: Evaluator + ?Sized, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    worker: &mut E::Worker,
+    networks: &S,
+    range: Range<usize>,
+    streams: &StreamFamily,
+) -> Result<Vec<f64>> {
+    range
+        .map(|j| evaluator.evaluate(worker, &networks.network(j), &mut streams.stream(j)))
+        .collect()
+}
+
+/// An [`Evaluator`] from a plain function.
+pub struct FnEvaluator<F> {
+    inputs: usize,
+    outputs: usize,
+    function: F,
+}
+
+impl<F> FnEvaluator<F>
+where
+    F: Fn(&Network, &mut Stream) -> Result<f64> + Sync,
+{
+    /// Wraps `function`, which scores networks of `inputs` inputs and `outputs` outputs.
+    pub fn new(inputs: usize, outputs: usize, function: F) -> Self {
+        FnEvaluator {
+            inputs,
+            outputs,
+            function,
+        }
+    }
+}
+
+impl<F> Evaluator for FnEvaluator<F>
+where
+    F: Fn(&Network, &mut Stream) -> Result<f64> + Sync,
+{
+    type Worker = ();
+    fn inputs(&self) -> usize {
+        self.inputs
+    }
+    fn outputs(&self) -> usize {
+        self.outputs
+    }
+    fn worker(&self) -> Result<()> {
+        Ok(())
+    }
+    fn evaluate(&self, _: &mut (), network: &Network, rng: &mut Stream) -> Result<f64> {
+        (self.function)(network, rng)
+    }
+}
+
+/// Evaluates `networks` in parallel on the current rayon pool; network `j`
+/// gets the stream `stream(seed, [key.., j])`. A batched evaluator gets
+/// them in batches of its [`Evaluator::batch_size`], which the threads take
+/// as they come free, any other one network at a time. The result is in order and independent of
+/// the thread count and of the batching.
+pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    networks: &S,
+    seed: u64,
+    key: &[u64],
+) -> Result<Vec<f64>, RunError> {
+    let streams = StreamFamily::new(seed, key);
+    if evaluator.batch_size() > 1 {
+        return evaluate_batches(evaluator, networks, &streams);
+    }
+    (0..networks.len())
+        .into_par_iter()
+        .map_init(
+            || evaluator.worker().map_err(|e| format!("{e:#}")),
+            |worker, j| {
+                let worker = worker.as_mut().map_err(|e| RunError::Worker(anyhow!("{e}")))?;
+                let fitness = evaluator.evaluate(worker, &networks.network(j), &mut streams.stream(j))?;
+                check_fitness(&[fitness], j)?;
+                Ok(fitness)
+            },
+        )
+        .collect()
+}
+
+/// An error naming the first network whose fitness is NaN; `first` is the
+/// index of `fitness[0]`.
+fn check_fitness(fitness: &[f64], first: usize) -> Result<(), RunError> {
+    match fitness.iter().position(|f| f.is_nan()) {
+        Some(i) => Err(RunError::NanFitness { network: first + i }),
+        None => Ok(()),
+    }
+}
+
+/// The batches [`evaluate_batches`] hands to rayon, in order: the full
+/// batches of `size` networks, then the tail (the fewer than `size` left)
+/// cut into one piece per thread, but never into pieces of fewer than
+/// `narrowest` networks (see [`Evaluator::narrowest_batch`]), so that a
+/// tail that narrow stays whole.
+fn batch_ranges(networks: usize, size: usize, narrowest: usize, threads: usize) -> Vec<Range<usize>> {
+    let size = size.max(1);
+    let narrowest = narrowest.clamp(1, size);
+    let full = networks / size * size;
+    let mut ranges: Vec<Range<usize>> = (0..full).step_by(size).map(|start| start..start + size).collect();
+    let tail = networks - full;
+    if tail > 0 {
+        let pieces = threads.clamp(1, (tail / narrowest).max(1));
+        let (base, longer) = (tail / pieces, tail % pieces);
+        let mut start = full;
+        for piece in 0..pieces {
+            let end = start + base + usize::from(piece < longer);
+            ranges.push(start..end);
+            start = end;
+        }
+    }
+    ranges
+}
+
+/// [`evaluate_all`] for a batched evaluator: the batches of
+/// [`batch_ranges`] on the current rayon pool, each taken by whichever
+/// thread is free (rayon's work stealing, so a thread slowed down on a
+/// shared host does less of the work), a worker made for each of rayon's
+/// tasks. Waiting threads sleep as rayon puts them to sleep; none spins.
+/// The first error in network order is the one returned.
+fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    networks: &S,
+    streams: &StreamFamily,
+) -> Result<Vec<f64>, RunError> {
+    let ranges = batch_ranges(
+        networks.len(),
+        evaluator.batch_size(),
+        evaluator.narrowest_batch(),
+        rayon::current_num_threads(),
+    );
+    let pieces: Vec<Result<Vec<f64>, RunError>> = ranges
+        .into_par_iter()
+        .with_max_len(1)
+        .map_init(
+            || None,
+            |worker: &mut Option<E::Worker>, range| {
+                let worker = match worker {
+                    Some(worker) => worker,
+                    None => worker.insert(evaluator.worker().map_err(RunError::Worker)?),
+                };
+                let start = range.start;
+                let fitness = evaluator.evaluate_batch(worker, networks, range, streams)?;
+                check_fitness(&fitness, start)?;
+                Ok(fitness)
+            },
+        )
+        .collect();
+    let mut fitness = Vec::with_capacity(networks.len());
+    for piece in pieces {
+        fitness.extend(piece?);
+    }
+    Ok(fitness)
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::Rng;
+
+    use super::*;
+    use crate::rng::stream;
+
+    /// A batched evaluator whose fitness is network `j`'s first gene plus
+    /// the first draw of its stream; `fail_at` makes the network with that
+    /// first gene an error, `nan_at` a NaN, and any gene from `panic_from`
+    /// on a panic.
+    struct Batched {
+        fail_at: Option<f64>,
+        nan_at: Option<f64>,
+        panic_from: Option<f64>,
+    }
+
+    impl Evaluator for Batched {
+        type Worker = ();
+        fn inputs(&self) -> usize {
+            1
+        }
+        fn outputs(&self) -> usize {
+            1
+        }
+        fn worker(&self) -> Result<()> {
+            Ok(())
+        }
+        fn evaluate(&self, _: &mut (), network: &Network, rng: &mut Stream) -> Result<f64> {
+            let gene = network.neuron(0)[0];
+            assert!(self.panic_from.is_none_or(|from| gene < from), "evaluator panicked");
+            if Some(gene) == self.fail_at {
+                return Err(anyhow!("network with gene {gene} failed"));
+            }
+            if Some(gene) == self.nan_at {
+                return Ok(f64::NAN);
+            }
+            Ok(gene + (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+        }
+        fn batch_size(&self) -> usize {
+            8
+        }
+    }
+
+    fn networks(count: usize) -> Vec<Network> {
+        (0..count)
+            .map(|j| Network::from_genes(1, 1, vec![j as f64, 0.5]).expect("finite genes"))
+            .collect()
+    }
+
+    fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+    }
+
+    const CLEAN: Batched = Batched {
+        fail_at: None,
+        nan_at: None,
+        panic_from: None,
+    };
+
+    #[test]
+    fn full_batches_come_first_then_one_piece_of_the_tail_per_thread() {
+        let mut expected: Vec<_> = (0..12).map(|b| b * 32..(b + 1) * 32).collect();
+        expected.push(384..400);
+        assert_eq!(batch_ranges(400, 32, 1, 1), expected);
+        expected.pop();
+        expected.extend([384..392, 392..400]);
+        assert_eq!(batch_ranges(400, 32, 1, 2), expected);
+        assert_eq!(batch_ranges(7, 32, 1, 3), [0..3, 3..5, 5..7]);
+        assert!(batch_ranges(0, 32, 1, 2).is_empty());
+    }
+
+    #[test]
+    fn the_tail_is_not_cut_narrower_than_the_evaluator_asks() {
+        let ranges = batch_ranges(400, 32, 16, 2);
+        assert_eq!((ranges.len(), ranges[12].clone()), (13, 384..400));
+        assert_eq!(batch_ranges(20, 32, 8, 3), [0..10, 10..20]);
+        assert_eq!(batch_ranges(5, 32, 8, 3).as_slice(), std::slice::from_ref(&(0..5)));
+    }
+
+    #[test]
+    fn the_batches_cover_every_network_once_in_order() {
+        for networks in 0..100 {
+            for (size, narrowest) in [(1, 1), (8, 1), (8, 3), (8, 8), (16, 16)] {
+                for threads in 1..5 {
+                    let ranges = batch_ranges(networks, size, narrowest, threads);
+                    let covered: Vec<usize> = ranges.iter().cloned().flatten().collect();
+                    assert_eq!(covered, (0..networks).collect::<Vec<_>>());
+                    assert!(ranges.iter().all(|r| r.len() <= size && !r.is_empty()));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn batches_give_each_network_its_own_stream_whatever_the_thread_count() {
+        let nets = networks(45);
+        let expected: Vec<f64> = nets
+            .iter()
+            .enumerate()
+            .map(|(j, n)| CLEAN.evaluate(&mut (), n, &mut stream(5, &[3, 9, j as u64])).unwrap())
+            .collect();
+        for threads in [1, 2, 3, 5] {
+            for _ in 0..20 {
+                let got = pool(threads)
+                    .install(|| evaluate_all(&CLEAN, &nets[..], 5, &[3, 9]))
+                    .unwrap();
+                assert_eq!(got, expected, "{threads} threads");
+            }
+        }
+        assert!(pool(2)
+            .install(|| evaluate_all(&CLEAN, &[] as &[Network], 5, &[]))
+            .unwrap()
+            .is_empty());
+    }
+
+    #[test]
+    fn an_error_or_nan_in_any_batch_names_its_network() {
+        let nets = networks(40);
+        for threads in [1, 2, 4] {
+            let failing = Batched {
+                fail_at: Some(33.0),
+                ..CLEAN
+            };
+            let error = pool(threads)
+                .install(|| evaluate_all(&failing, &nets[..], 1, &[]))
+                .unwrap_err();
+            assert!(format!("{error:#}").contains("gene 33 failed"), "{error:#}");
+            let nan = Batched {
+                nan_at: Some(21.0),
+                ..CLEAN
+            };
+            let error = pool(threads)
+                .install(|| evaluate_all(&nan, &nets[..], 1, &[]))
+                .unwrap_err();
+            assert!(error.to_string().contains("NaN for network 21"), "{error}");
+        }
+    }
+
+    #[test]
+    fn concurrent_evaluations_on_a_busy_pool_finish_with_the_right_results() {
+        // As in `replicate`: every thread runs work of its own that calls
+        // evaluate_all again and again, so no thread is free to take
+        // another's batches; each must evaluate its own.
+        let nets = networks(50);
+        let expected = pool(1).install(|| evaluate_all(&CLEAN, &nets[..], 2, &[7])).unwrap();
+        let runs: Vec<Vec<f64>> = pool(2).install(|| {
+            (0..6)
+                .into_par_iter()
+                .map(|_| {
+                    let mut last = Vec::new();
+                    for _ in 0..200 {
+                        last = evaluate_all(&CLEAN, &nets[..], 2, &[7]).unwrap();
+                    }
+                    last
+                })
+                .collect()
+        });
+        assert!(runs.iter().all(|r| *r == expected));
+    }
+
+    #[test]
+    #[should_panic(expected = "evaluator panicked")]
+    fn a_panicking_batch_panics_the_caller_instead_of_leaving_it_waiting() {
+        let panicking = Batched {
+            panic_from: Some(30.0),
+            ..CLEAN
+        };
+        let _ = pool(2).install(|| evaluate_all(&panicking, &networks(40)[..], 1, &[]));
+    }
+}

@@ -1,0 +1,48 @@
+//! `psa-esp sweep`: the grid for each value, or each combination of values, of any settings.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+
+use super::replicate::{GridArgs, Progress};
+use crate::experiment::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
+
+/// Arguments of `sweep`.
+#[derive(Debug, clap::Args)]
+pub struct SweepArgs {
+    /// A setting and its values, KEY=V1,V2,... with KEY as in a configuration
+    /// file (e.g. esp.stagnation=20,40,70 or problem.tasks.task2_spin=0,1);
+    /// repeat for more settings.
+    #[arg(long = "vary", required = true)]
+    pub vary: Vec<String>,
+    /// combinations: every combination of the values; one-at-a-time: each
+    /// setting alone (the others at the base), plus the base.
+    #[arg(long, value_enum, default_value_t = SweepMode::Combinations)]
+    pub mode: SweepMode,
+    /// The grid each variant runs.
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// The sweep's directory; running the same command again resumes it.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs `sweep`.
+pub fn run(args: SweepArgs) -> Result<i32> {
+    let vary = args.vary.iter().map(|v| parse_vary(v)).collect::<Result<Vec<_>>>()?;
+    let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
+    let progress = Progress::new();
+    let summary = sweep(&args.out, &spec, args.grid.jobs as usize, &progress)?;
+    progress.bar.finish_and_clear();
+    say!(
+        "sweep {}: {} variants, {} runs, {} already finished, {} run now in {:.0} s",
+        args.out.display(),
+        summary.variants,
+        summary.total,
+        summary.skipped,
+        summary.ran,
+        summary.seconds
+    );
+    say!("next: psa-esp report {}", args.out.display());
+    Ok(0)
+}

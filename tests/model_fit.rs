@@ -1,0 +1,235 @@
+//! The model fitted to the paper's evidence (docs/model.md): what doing
+//! nothing scores, the earlier defaults kept as a configuration file that
+//! repeats earlier runs byte for byte, champions that carry their model,
+//! and sweeps end to end.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use psa_esp::network::Network;
+use psa_esp::physics::BackendKind;
+use psa_esp::psa::{PsaSettings, Task, TrialRunner};
+use psa_esp::rng::stream;
+
+fn psa_esp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_psa-esp"))
+        .args(args)
+        .output()
+        .expect("run psa-esp")
+}
+
+fn ok(o: &Output) -> String {
+    assert!(
+        o.status.success(),
+        "exit {:?}: {}",
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// A network whose four outputs are all about 1e-13: it does nothing.
+fn idle_network() -> Network {
+    let mut genes = vec![0.0; 6];
+    genes.push(6.0); // the hidden unit sits near 1
+    genes.extend([-30.0; 4]);
+    Network::from_genes(7, 4, genes).unwrap()
+}
+
+#[test]
+fn doing_nothing_scores_under_1_percent_on_task_2_and_a_few_on_tasks_1_and_3() {
+    for backend in [BackendKind::Ode, BackendKind::Native] {
+        let settings = PsaSettings {
+            backend,
+            ..PsaSettings::default()
+        };
+        let score = |task| {
+            TrialRunner::new(&settings, task)
+                .unwrap()
+                .evaluate(&idle_network(), &mut stream(1, &[]))
+                .unwrap()
+        };
+        // A stagnated task-2 run whose champion earns 1 point of 2000 (the
+        // paper's section 5.1) needs a start where doing nothing earns nothing.
+        assert!(score(Task::Turn) < 1.0, "{backend}: task 2 {}", score(Task::Turn));
+        assert!(
+            score(Task::StopRotation) <= 3.0,
+            "{backend}: task 1 {}",
+            score(Task::StopRotation)
+        );
+        // Task 3: coasting through the box at 0.3 m/s on the target heading.
+        assert!(
+            score(Task::StopAtPosition) <= 5.5,
+            "{backend}: task 3 {}",
+            score(Task::StopAtPosition)
+        );
+    }
+}
+
+#[test]
+fn the_previous_defaults_file_repeats_the_earlier_records_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = repo("configs/previous-defaults.toml");
+    // Recorded by the build before the fit (6631aa9): seed 7, 120 generations, native.
+    for preset in ["baseline", "max-credit", "hill-climb"] {
+        for task in ["1", "2", "3"] {
+            let out = dir.path().join(format!("{preset}-t{task}"));
+            ok(&psa_esp(&[
+                "evolve",
+                "--task",
+                task,
+                "--preset",
+                preset,
+                "--seed",
+                "7",
+                "--generations",
+                "120",
+                "--backend",
+                "native",
+                "--config",
+                config.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ]));
+            let golden = std::fs::read(repo(&format!("tests/golden/previous-defaults/{preset}-t{task}.csv"))).unwrap();
+            let records = std::fs::read(out.join("records.csv")).unwrap();
+            assert!(
+                records == golden,
+                "{preset} task {task}: records.csv differs from the earlier build's"
+            );
+        }
+    }
+}
+
+#[test]
+fn replay_flies_a_champion_on_the_model_it_was_evolved_under() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("model.toml");
+    // A model unlike the default: faster task-3 start, other input scaling.
+    std::fs::write(
+        &config,
+        "[problem.tasks]\ntask3_speed = 0.25\n[problem.sensors]\nposition_scale = 3.0\n",
+    )
+    .unwrap();
+    let out = dir.path().join("run");
+    let args = [
+        "evolve",
+        "--task",
+        "3",
+        "--generations",
+        "6",
+        "--backend",
+        "native",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    ok(&psa_esp(&args));
+    let run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let evolved = run["champion_fitness"].as_f64().unwrap();
+    let champion = out.join("champion.json");
+    let replay = |extra: &[&str]| -> f64 {
+        let mut args = vec![
+            "replay",
+            champion.to_str().unwrap(),
+            "--backend",
+            "native",
+            "--json",
+            "--out",
+        ];
+        let pictures = dir.path().join("replay");
+        args.push(pictures.to_str().unwrap());
+        args.extend(extra);
+        let json: serde_json::Value = serde_json::from_str(&ok(&psa_esp(&args))).unwrap();
+        json["fitness_percent_mean"].as_f64().unwrap()
+    };
+    assert_eq!(replay(&[]), evolved, "the recorded model gives the evolved fitness");
+    let on_default = replay(&["--default-model"]);
+    assert_ne!(on_default, evolved, "the default model is another model");
+    // --config lays settings over the recorded model: setting them back to
+    // the default model's values gives the default model's score.
+    let back = dir.path().join("back.toml");
+    let defaults = PsaSettings::default();
+    std::fs::write(
+        &back,
+        format!(
+            "[problem.tasks]\ntask3_speed = {:?}\n[problem.sensors]\nposition_scale = {:?}\n",
+            defaults.tasks.task3_speed, defaults.sensors.position_scale
+        ),
+    )
+    .unwrap();
+    assert_eq!(replay(&["--config", back.to_str().unwrap()]), on_default);
+}
+
+#[test]
+fn a_sweep_runs_a_grid_per_variant_and_reports_the_distance_and_sensitivity() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let args = [
+        "sweep",
+        "--vary",
+        "esp.stagnation=3,5",
+        "--vary",
+        "problem.tasks.task3_speed=0.1,0.2",
+        "--configs",
+        "baseline,max-credit",
+        "--seeds",
+        "2",
+        "--generations",
+        "12",
+        "--robustness-trials",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let first = ok(&psa_esp(&args));
+    assert!(first.contains("4 variants, 48 runs"), "{first}");
+    // Again: resumed, nothing to do.
+    let again = ok(&psa_esp(&args));
+    assert!(again.contains("48 already finished, 0 run now"), "{again}");
+    // Another definition on the same folder is refused.
+    let mut other = args.to_vec();
+    other[2] = "esp.stagnation=3,6";
+    let o = psa_esp(&other);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("another definition"));
+    // Each variant is an ordinary grid with its settings recorded.
+    let variant = out.join("variants/v1-esp.stagnation=3+problem.tasks.task3_speed=0.2");
+    let config = std::fs::read_to_string(variant.join("runs/baseline/task3/seed1/config.toml")).unwrap();
+    assert!(
+        config.contains("stagnation = 3") && config.contains("task3_speed = 0.2"),
+        "{config}"
+    );
+    // The same seed gives the same run in a variant that only changes task 3's start on another task.
+    let records =
+        |v: &str| std::fs::read(out.join(format!("variants/{v}/runs/baseline/task1/seed2/records.csv"))).unwrap();
+    assert_eq!(
+        records("v0-esp.stagnation=3+problem.tasks.task3_speed=0.1"),
+        records("v1-esp.stagnation=3+problem.tasks.task3_speed=0.2")
+    );
+    let report = ok(&psa_esp(&["report", out.to_str().unwrap()]));
+    assert!(report.contains("# Sweep report"), "{report}");
+    assert!(report.contains("| `esp.stagnation` | 3, 5 |"), "{report}");
+    assert!(report.contains("Closest to the paper"), "{report}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sweep-report.json")).unwrap()).unwrap();
+    let variants = json["variants"].as_array().unwrap();
+    assert_eq!(variants.len(), 4);
+    for v in variants {
+        let d = &v["distance"];
+        // Table 1 (3) + Table 2 (5) + both burst totals: every term has runs here.
+        assert_eq!(d["terms"].as_array().unwrap().len(), 10, "{d}");
+        let total: f64 = d["terms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["z"].as_f64().unwrap().powi(2))
+            .sum();
+        assert!((total - d["total"].as_f64().unwrap()).abs() < 1e-9);
+    }
+}
