@@ -6,7 +6,7 @@
 //! [`Lanes`] (one value per network evaluated in lockstep) for the batched
 //! path. Both instantiate the very same sequence of IEEE-754 operations
 //! (additions, multiplications, fused multiply-adds where the code says
-//! [`Real::mul_add`], divisions, square roots, comparisons; never a library
+//! [`mul_add`](esp_neuroevolution::math::Float::mul_add), divisions, square roots, comparisons; never a library
 //! call whose result could differ), so the two paths give bit-identical
 //! results on every CPU, whatever SIMD width [`SimdLevel`] picks at run
 //! time. A fused multiply-add rounds once, exactly as IEEE-754 defines it,
