@@ -172,15 +172,20 @@ fn blocks_of_every_width_and_ranges_of_a_set_give_the_same_fitness_as_a_full_blo
 
 #[test]
 fn a_network_whose_thrust_turns_nan_gets_the_scalar_paths_error() {
-    // Finite weights cannot make NaN (every sum is a fused multiply-add),
-    // but an absurd input scale can: on task 3 the y input becomes -inf,
-    // and its weight of 0 times -inf is NaN. With and without output noise
-    // (the noisy kernel is compiled apart).
+    // Inputs inside their ranges are finite, but weights near f64::MAX can
+    // still overflow a hidden neuron's sum both ways: on task 3 the PSA
+    // starts moving at +0.3 m/s along y (input vy = 3), whose weight of
+    // -1e308 gives -inf, and the bias input of 10 with a weight of 1e308
+    // gives +inf; their sum is NaN. With and without output noise (the
+    // noisy kernel is compiled apart).
     for output_sd in [0.0, 0.1] {
         let mut settings = native(PsaSettings::default());
-        settings.sensors.position_scale = 1e308;
+        settings.tasks.task3_speed = 0.3;
+        settings.sensors.bias = 10.0;
         settings.noise.output_sd = output_sd;
         let mut genes = vec![0.0; 11];
+        genes[3] = -1e308;
+        genes[6] = 1e308;
         genes[7..11].copy_from_slice(&[1.0; 4]);
         let bad = Network::from_genes(7, 4, genes).unwrap();
         let good = random_network(1);
