@@ -25,7 +25,7 @@ pub enum SettingsError {
         value: f64,
     },
     /// A scale, limit or constant above [`MAX_REAL_SETTING`](crate::MAX_REAL_SETTING).
-    #[error("{name} must be at most {max:e}, got {value:e}")]
+    #[error("{name} must be in (0, {max:e}], got {value:e}")]
     TooLarge {
         /// The setting.
         name: &'static str,

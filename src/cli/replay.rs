@@ -26,10 +26,10 @@ pub struct ReplayArgs {
     #[arg(long, value_enum, default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Standard deviation of Gaussian noise on every input but the bias.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub input_noise: f64,
     /// Standard deviation of Gaussian noise on every output (before clamping).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub output_noise: f64,
     /// Random initial conditions (tasks 1 and 3).
     #[arg(long)]
