@@ -4,6 +4,7 @@
 use std::fs;
 use std::io::{BufWriter, Read, Write};
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context, Result};
 
@@ -73,8 +74,11 @@ fn describe_file_type(kind: &fs::FileType) -> &'static str {
 }
 
 /// Writes `contents` to `path` atomically: into a temporary file in the same
-/// directory, flushed to disk, then renamed over `path`. A crash leaves
-/// either the old file or the new one, never a torn one.
+/// directory, flushed to disk, then renamed over `path`, and the directory
+/// flushed too. A crash leaves either the old file or the new one, never a
+/// torn one. The temporary file's name holds the host, the process id and a
+/// counter, so that processes on several hosts sharing a file system never
+/// write into one another's (see [`temporary_name`]).
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     write_atomic_with(path, |w| Ok(w.write_all(contents)?))
 }
@@ -90,19 +94,85 @@ pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Resu
     let name = path
         .file_name()
         .with_context(|| format!("{} is not a file path", path.display()))?;
-    let tmp = dir.join(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
+    let tmp = dir.join(temporary_name(&name.to_string_lossy()));
     let result = (|| -> Result<()> {
         let mut file = BufWriter::new(fs::File::create(&tmp)?);
         write(&mut file)?;
         let file = file.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
         fs::rename(&tmp, path)?;
+        sync_dir(dir)?;
         Ok(())
     })();
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
     }
     result.with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Creates `path` with `contents` unless it exists: `Ok(true)` when this
+/// call created it, `Ok(false)` when it was already there (its contents
+/// untouched). The file appears whole: it is written under a temporary name
+/// and hard-linked to `path`, which fails when `path` exists; on a file
+/// system without hard links it is created exclusively and then written.
+/// Several processes on several hosts may race for one `path`: exactly one
+/// creates it.
+pub fn create_new_atomic(path: &Path, contents: &[u8]) -> Result<bool> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .with_context(|| format!("{} is not a file path", path.display()))?;
+    let tmp = dir.join(temporary_name(&name.to_string_lossy()));
+    let result = (|| -> std::io::Result<bool> {
+        let mut file = fs::File::create(&tmp)?;
+        file.write_all(contents)?;
+        file.sync_all()?;
+        let created = match fs::hard_link(&tmp, path) {
+            Ok(()) => true,
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => false,
+            Err(_) => match fs::File::create_new(path) {
+                Ok(mut file) => {
+                    file.write_all(contents)?;
+                    file.sync_all()?;
+                    true
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => false,
+                Err(e) => return Err(e),
+            },
+        };
+        if created {
+            sync_dir(dir)?;
+        }
+        Ok(created)
+    })();
+    let _ = fs::remove_file(&tmp);
+    result.with_context(|| format!("cannot create {}", path.display()))
+}
+
+/// The name of a temporary file beside `name`: `.NAME.tmp-HOST-PID-N`, with
+/// N counting this process's temporary files. Unique across the processes
+/// and hosts that share a file system.
+pub fn temporary_name(name: &str) -> String {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    format!(
+        ".{name}.tmp-{}-{}-{}",
+        crate::provenance::host_name(),
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    )
+}
+
+/// Flushes the directory `dir` to disk, so that a rename into it survives
+/// a crash (on Unix; elsewhere there is nothing to flush).
+pub fn sync_dir(dir: &Path) -> std::io::Result<()> {
+    #[cfg(unix)]
+    fs::File::open(dir)?.sync_all()?;
+    #[cfg(not(unix))]
+    let _ = dir;
+    Ok(())
 }
 
 /// Writes `value` to `path` atomically as pretty JSON with a final newline.
@@ -137,6 +207,35 @@ pub fn read_versioned_json<T: serde::de::DeserializeOwned>(
         );
     }
     serde_json::from_value(value).with_context(|| format!("{}", path.display()))
+}
+
+/// A `u64` written to JSON as a string (`"18446744073709551615"`), read
+/// back from a string or a number. JSON tools that read numbers as doubles
+/// (jq, JavaScript, Python's `float`) lose digits above 2^53; a string keeps
+/// every seed exact. Use with `#[serde(with = "crate::io::u64_string")]`.
+pub mod u64_string {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    /// Writes `value` as a decimal string.
+    pub fn serialize<S: Serializer>(value: &u64, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(value)
+    }
+
+    /// Reads a `u64` from a decimal string or a JSON number.
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<u64, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Either {
+            Number(u64),
+            Text(String),
+        }
+        match Either::deserialize(deserializer)? {
+            Either::Number(n) => Ok(n),
+            Either::Text(text) => text
+                .parse()
+                .map_err(|_| serde::de::Error::custom(format!("{text:?} is not a whole number in [0, 2^64)"))),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -184,5 +283,51 @@ mod tests {
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file left");
         write_atomic_with(&path, |w| Ok(w.write_all(b"new\n")?)).unwrap();
         assert_eq!(fs::read_to_string(&path).unwrap(), "new\n");
+    }
+
+    #[derive(Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+    struct Seeded {
+        #[serde(with = "u64_string")]
+        seed: u64,
+    }
+
+    #[test]
+    fn seeds_are_written_as_strings_and_read_from_either_form() {
+        for seed in [0, 1, (1 << 53) + 1, u64::MAX] {
+            let json = serde_json::to_string(&Seeded { seed }).unwrap();
+            assert_eq!(json, format!("{{\"seed\":\"{seed}\"}}"));
+            assert_eq!(serde_json::from_str::<Seeded>(&json).unwrap().seed, seed);
+            let number = format!("{{\"seed\":{seed}}}");
+            assert_eq!(serde_json::from_str::<Seeded>(&number).unwrap().seed, seed);
+        }
+        for bad in [
+            r#"{"seed":"-1"}"#,
+            r#"{"seed":"18446744073709551616"}"#,
+            r#"{"seed":1.5}"#,
+            r#"{"seed":"x"}"#,
+        ] {
+            assert!(serde_json::from_str::<Seeded>(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn a_new_file_is_created_once_and_never_overwritten() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("grid.json");
+        assert!(create_new_atomic(&path, b"first\n").unwrap());
+        assert!(!create_new_atomic(&path, b"second\n").unwrap());
+        assert_eq!(fs::read_to_string(&path).unwrap(), "first\n");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary file left");
+    }
+
+    #[test]
+    fn temporary_names_hold_host_and_pid() {
+        let (a, b) = (temporary_name("run.json"), temporary_name("run.json"));
+        assert_ne!(a, b);
+        let host = crate::provenance::host_name();
+        assert!(
+            a.starts_with(&format!(".run.json.tmp-{host}-{}-", std::process::id())),
+            "{a}"
+        );
     }
 }

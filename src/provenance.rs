@@ -38,3 +38,24 @@ pub fn build_info() -> BuildInfo {
 pub fn now_rfc3339() -> String {
     humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
 }
+
+/// This host's name: `/proc/sys/kernel/hostname` on Linux, else `$HOSTNAME`,
+/// else `localhost`; any character but ASCII letters, digits, `.`, `-` and
+/// `_` is replaced by `_`, so that it can go into a file name.
+pub fn host_name() -> String {
+    let name = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|n| n.trim().to_string())
+        .filter(|n| !n.is_empty())
+        .unwrap_or_else(|| "localhost".into());
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::evolution::{Esp, Evaluator};
 use crate::experiment::grid::{GridPreset, GridSpec};
-use crate::experiment::replicate::{replicate, FinishedRun, GridProgress};
+use crate::experiment::replicate::{replicate, FinishedRun, GridProgress, ReplicateOptions};
 use crate::experiment::{GridConfig, Preset, PsaEvaluator, RunConfig};
 use crate::network::{Network, NetworkSet};
 use crate::physics::BackendKind;
@@ -135,7 +135,11 @@ pub fn replicate_workload(generations: usize) -> Result<Workload> {
         ),
         work: Box::new(move |threads| {
             let dir = tempfile::Builder::new().prefix("psa-esp-bench-").tempdir()?;
-            replicate(dir.path(), &spec, threads, &Silent)?;
+            let options = ReplicateOptions {
+                threads,
+                ..ReplicateOptions::default()
+            };
+            replicate(dir.path(), &spec, &options, &Silent)?;
             Ok(())
         }),
     })

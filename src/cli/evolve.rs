@@ -32,7 +32,7 @@ pub struct EvolveArgs {
     #[arg(long, value_enum)]
     pub backend: Option<BackendKind>,
     /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
+    #[arg(long, alias = "jobs", default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
     pub threads: u64,
     /// Output directory (default: evolve-<preset>-task<T>-seed<S>).
     #[arg(long)]

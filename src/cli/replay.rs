@@ -64,6 +64,7 @@ struct ReplaySummary {
     task: Task,
     backend: BackendKind,
     trials: u64,
+    #[serde(serialize_with = "crate::io::u64_string::serialize")]
     seed: u64,
     input_noise: f64,
     output_noise: f64,

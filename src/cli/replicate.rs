@@ -1,14 +1,17 @@
 //! `psa-esp replicate`: the paper's experiment grid.
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
 
 use super::evolve::progress_bar;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
-use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress};
+use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress, HeldRun, ReplicateOptions};
+use crate::experiment::shard::Shard;
 use crate::experiment::GridConfig;
 use crate::ode::MAX_THREADS;
 use crate::physics::BackendKind;
@@ -31,7 +34,7 @@ pub struct ReplicateArgs {
 pub struct GridArgs {
     /// quick: a reduced grid (5 seeds, 80 generations, 100-trial robustness,
     /// native backend; about a minute on 2 cores); paper: the full protocol
-    /// (30 seeds, 2000 generations, 500-trial robustness, ode backend).
+    /// (30 seeds, 2000 generations, 500-trial robustness, native backend).
     #[arg(long, value_enum, default_value_t = GridPreset::Quick)]
     pub preset: GridPreset,
     /// Configurations, comma-separated (default: all of baseline, systematic,
@@ -58,8 +61,30 @@ pub struct GridArgs {
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
-    pub jobs: u64,
+    #[arg(long, alias = "jobs", default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
+    pub threads: u64,
+    /// Run only shard I of N (I from 0): runs I, I+N, I+2N, ... of the
+    /// grid's run order, into the same --out (e.g. one per task of a SLURM
+    /// job array). Results do not depend on it.
+    #[arg(long, value_name = "I/N", default_value_t = Shard::ALL)]
+    pub shard: Shard,
+    /// How long another process's claim on a run (its claim.json) holds
+    /// before this process takes the run over, e.g. 48h or 90m; a claim of a
+    /// process of this host that is gone is taken over at once.
+    #[arg(long, value_name = "DURATION", default_value = "48h", value_parser = parse_duration)]
+    pub claim_timeout: Duration,
+    /// Print nothing while the grid runs (no bars, no lines per run).
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// A duration such as `48h`, `90m` or `1h 30m`, above zero.
+fn parse_duration(text: &str) -> Result<Duration, String> {
+    match humantime::parse_duration(text) {
+        Ok(d) if !d.is_zero() => Ok(d),
+        Ok(_) => Err("the duration must be above zero".into()),
+        Err(e) => Err(format!("{e} (write e.g. 48h, 90m or 1h 30m)")),
+    }
 }
 
 impl GridArgs {
@@ -81,6 +106,15 @@ impl GridArgs {
         spec.robustness_trials = self.robustness_trials.map_or(spec.robustness_trials, |t| t as usize);
         Ok(spec)
     }
+
+    /// How the grid runs: threads, shard and claim timeout.
+    pub fn options(&self) -> ReplicateOptions {
+        ReplicateOptions {
+            threads: self.threads as usize,
+            shard: self.shard,
+            claim_timeout: self.claim_timeout,
+        }
+    }
 }
 
 /// The text of a `--config` file, checked to be a valid overlay of the baseline.
@@ -91,64 +125,120 @@ pub fn read_overrides(path: &std::path::Path) -> Result<String> {
     Ok(text)
 }
 
-/// A bar over the whole grid and a line per finished run (both only on a terminal).
+/// What the user sees while a grid runs: on a terminal, a bar over the
+/// grid and a line per finished run above it; otherwise (a pipe, a file, a
+/// batch job) a plain line per finished run with the count and an ETA;
+/// nothing with `--quiet`.
 pub struct Progress {
-    /// The bar.
+    /// The bar (hidden unless standard error is a terminal).
     pub bar: indicatif::ProgressBar,
-    best: Mutex<f64>,
+    lines: bool,
+    state: Mutex<ProgressState>,
 }
 
-impl Default for Progress {
-    fn default() -> Self {
-        Progress::new()
-    }
+/// The counts behind [`Progress`].
+struct ProgressState {
+    total: usize,
+    done: usize,
+    ran: usize,
+    best: f64,
+    clock: Instant,
 }
 
 impl Progress {
-    /// A bar with no runs yet.
-    pub fn new() -> Progress {
+    /// A bar on a terminal, lines elsewhere, nothing when `quiet`.
+    pub fn new(quiet: bool) -> Progress {
+        let bar = progress_bar(
+            0,
+            "{spinner} runs {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
+        );
+        let terminal = std::io::stderr().is_terminal();
+        if quiet || !terminal {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+        }
         Progress {
-            bar: progress_bar(
-                0,
-                "{spinner} runs {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
-            ),
-            best: Mutex::new(f64::NEG_INFINITY),
+            bar,
+            lines: !quiet && !terminal,
+            state: Mutex::new(ProgressState {
+                total: 0,
+                done: 0,
+                ran: 0,
+                best: f64::NEG_INFINITY,
+                clock: Instant::now(),
+            }),
         }
     }
 }
 
 impl GridProgress for Progress {
     fn start(&self, total: usize, done: usize) {
+        let mut state = self.state.lock().expect("no panics while holding the lock");
+        *state = ProgressState {
+            total,
+            done,
+            ran: 0,
+            best: state.best,
+            clock: Instant::now(),
+        };
         self.bar.set_length(total as u64);
         self.bar.set_position(done as u64);
         self.bar.reset_eta();
     }
 
     fn finished(&self, run: &FinishedRun) {
-        let mut best = self.best.lock().expect("no panics while holding the lock");
-        *best = best.max(run.outcome.champion_fitness);
-        self.bar.println(format!(
+        let mut state = self.state.lock().expect("no panics while holding the lock");
+        state.best = state.best.max(run.outcome.champion_fitness);
+        state.done += 1;
+        state.ran += 1;
+        let what = format!(
             "finished {} task {} seed {}: champion {:.1} % ({:.0} s)",
             run.key.config, run.key.task, run.key.seed, run.outcome.champion_fitness, run.outcome.seconds
-        ));
-        self.bar.set_message(format!("best champion {:.1} %", *best));
+        );
+        if self.lines {
+            // Runs still to do at this process's pace so far.
+            let left = state.total.saturating_sub(state.done);
+            let eta = state.clock.elapsed().as_secs_f64() / state.ran as f64 * left as f64;
+            let eta = humantime::format_duration(Duration::from_secs(eta.round() as u64));
+            eprintln!("{what}; {}/{} runs done, ETA {eta}", state.done, state.total);
+        } else {
+            self.bar.println(what);
+        }
+        self.bar.set_message(format!("best champion {:.1} %", state.best));
         self.bar.inc(1);
+    }
+}
+
+/// Prints the runs other processes held, left to them.
+pub fn report_held<'a>(held: impl Iterator<Item = (String, &'a HeldRun)>) {
+    for (prefix, h) in held {
+        eprintln!(
+            "left to another process: {prefix}{} task {} seed {} (claimed by {})",
+            h.key.config, h.key.task, h.key.seed, h.claim
+        );
     }
 }
 
 /// Runs `replicate`.
 pub fn run(args: ReplicateArgs) -> Result<i32> {
     let spec = args.grid.spec()?;
-    let progress = Progress::new();
-    let summary = replicate(&args.out, &spec, args.grid.jobs as usize, &progress)?;
+    let progress = Progress::new(args.grid.quiet);
+    let options = args.grid.options();
+    let summary = replicate(&args.out, &spec, &options, &progress)?;
     progress.bar.finish_and_clear();
+    report_held(summary.held.iter().map(|h| (String::new(), h)));
+    let shard = if options.shard == Shard::ALL {
+        String::new()
+    } else {
+        format!(", shard {}", options.shard)
+    };
     say!(
-        "grid {} ({}): {} runs, {} already finished, {} run now in {:.0} s",
+        "grid {} ({}{shard}): {} runs, {} already finished, {} run now, {} left to other processes, in {:.0} s",
         args.out.display(),
         describe(&spec),
         summary.total,
         summary.skipped,
         summary.ran,
+        summary.held.len(),
         summary.seconds
     );
     say!("next: psa-esp report {}", args.out.display());

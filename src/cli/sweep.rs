@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
-use super::replicate::{GridArgs, Progress};
+use super::replicate::{report_held, GridArgs, Progress};
 use crate::experiment::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
 
 /// Arguments of `sweep`.
@@ -31,16 +31,18 @@ pub struct SweepArgs {
 pub fn run(args: SweepArgs) -> Result<i32> {
     let vary = args.vary.iter().map(|v| parse_vary(v)).collect::<Result<Vec<_>>>()?;
     let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
-    let progress = Progress::new();
-    let summary = sweep(&args.out, &spec, args.grid.jobs as usize, &progress)?;
+    let progress = Progress::new(args.grid.quiet);
+    let summary = sweep(&args.out, &spec, &args.grid.options(), &progress)?;
     progress.bar.finish_and_clear();
+    report_held(summary.held.iter().map(|(variant, h)| (format!("{variant}: "), h)));
     say!(
-        "sweep {}: {} variants, {} runs, {} already finished, {} run now in {:.0} s",
+        "sweep {}: {} variants, {} runs, {} already finished, {} run now, {} left to other processes, in {:.0} s",
         args.out.display(),
         summary.variants,
         summary.total,
         summary.skipped,
         summary.ran,
+        summary.held.len(),
         summary.seconds
     );
     say!("next: psa-esp report {}", args.out.display());

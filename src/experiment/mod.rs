@@ -1,6 +1,7 @@
 //! Experiments: the PSA as an evaluation function, run configurations and
 //! presets, and single evolution runs written to disk.
 
+pub mod claim;
 mod config;
 mod evaluator;
 pub mod grid;
@@ -8,6 +9,8 @@ pub mod replicate;
 pub mod report;
 pub mod robustness;
 mod run;
+pub mod runs_table;
+pub mod shard;
 pub mod stats;
 pub mod sweep;
 

@@ -1,18 +1,22 @@
 //! Running the replication grid: every (configuration, task, seed) as an
 //! independent run in its own folder, then its robustness tests; finished
-//! runs are skipped, so a killed grid resumes where it stopped.
+//! runs are skipped, so a killed grid resumes where it stopped. A process
+//! may run one shard of the grid ([`Shard`]), and several processes may
+//! work on one folder: each claims a run before running it ([`claim`]).
 
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
 use rand::RngExt;
 use rayon::prelude::*;
 
+use super::claim::{claim, Attempt, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
 use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
 use super::robustness::test_robustness;
+use super::shard::Shard;
 use super::{run_evolution, EvolveOutcome};
 use crate::psa::NetworkFile;
 
@@ -43,30 +47,79 @@ pub struct FinishedRun {
 
 /// Something to tell the user while the grid runs.
 pub trait GridProgress: Sync {
-    /// The grid has `total` runs, `done` of them finished before this call.
+    /// The grid (or this shard of it) has `total` runs, `done` of them
+    /// finished before this call.
     fn start(&self, total: usize, done: usize);
     /// A run finished.
     fn finished(&self, run: &FinishedRun);
 }
 
+/// How [`replicate`] runs: threads, shard, claims.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReplicateOptions {
+    /// Worker threads (0 = one per core). Results do not depend on it.
+    pub threads: usize,
+    /// Which runs of the grid's run order this process does.
+    pub shard: Shard,
+    /// How old another process's claim on a run may grow before this one
+    /// takes it over.
+    pub claim_timeout: Duration,
+}
+
+impl Default for ReplicateOptions {
+    fn default() -> Self {
+        ReplicateOptions {
+            threads: 0,
+            shard: Shard::ALL,
+            claim_timeout: DEFAULT_CLAIM_TIMEOUT,
+        }
+    }
+}
+
+/// A run another live process holds (and this one left to it).
+#[derive(Debug, Clone)]
+pub struct HeldRun {
+    /// The run.
+    pub key: RunKey,
+    /// Who holds it.
+    pub claim: ClaimRecord,
+}
+
 /// The summary of [`replicate`].
 #[derive(Debug, Clone)]
 pub struct ReplicateSummary {
-    /// Runs in the grid.
+    /// Runs in the grid (or in this shard of it).
     pub total: usize,
-    /// Runs that were already finished.
+    /// Runs that were already finished (by any process).
     pub skipped: usize,
-    /// Runs done now.
+    /// Runs done now by this process.
     pub ran: usize,
+    /// Runs other processes were running, left to them.
+    pub held: Vec<HeldRun>,
     /// Wall-clock seconds.
     pub seconds: f64,
 }
 
-/// Checks `dir` against `spec`: a new directory gets `grid.json`; an
-/// existing grid must have the same definition. Returns the runs to do.
-pub fn prepare(dir: &Path, spec: &GridSpec) -> Result<(Vec<RunKey>, usize)> {
+/// Checks `dir` against `spec`: a new directory gets `grid.json` (of
+/// processes starting together, exactly one writes it); an existing grid
+/// must have the same definition. Returns the runs of `shard` still to do,
+/// and how many of its runs are finished.
+pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard) -> Result<(Vec<RunKey>, usize)> {
     spec.validate()?;
-    if super::grid::grid_file(dir).exists() {
+    let grid_file = super::grid::grid_file(dir);
+    // `runs/` first: a grid's run folders appear only after its grid.json.
+    if dir.join("runs").exists() && !grid_file.exists() {
+        bail!(
+            "{} has run folders but no grid.json: not a grid this tool wrote; use another --out",
+            dir.display()
+        );
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut json = serde_json::to_string_pretty(spec)?;
+    json.push('\n');
+    if !grid_file.exists() && crate::io::create_new_atomic(&grid_file, json.as_bytes())? {
+        // This process wrote grid.json.
+    } else {
         let existing = GridSpec::load(dir)?;
         if existing != *spec {
             bail!(
@@ -75,19 +128,10 @@ pub fn prepare(dir: &Path, spec: &GridSpec) -> Result<(Vec<RunKey>, usize)> {
                 describe(&existing)
             );
         }
-    } else {
-        if dir.join("runs").exists() {
-            bail!(
-                "{} has run folders but no grid.json: not a grid this tool wrote; use another --out",
-                dir.display()
-            );
-        }
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        spec.save(dir)?;
     }
     let mut todo = Vec::new();
     let mut problems = Vec::new();
-    let runs = spec.runs();
+    let runs = shard.select(&spec.runs());
     for key in &runs {
         match run_status(dir, spec, key) {
             Ok(RunStatus::Finished) => {}
@@ -137,37 +181,77 @@ pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun>
     Ok(FinishedRun { key: *key, outcome })
 }
 
-/// Runs every unfinished run of `spec` in `dir` on `jobs` threads (0 = one
-/// per core). Results do not depend on `jobs` or on interruptions.
-pub fn replicate(dir: &Path, spec: &GridSpec, jobs: usize, progress: &dyn GridProgress) -> Result<ReplicateSummary> {
+/// What became of one run this process went for.
+enum Outcome {
+    /// This process ran it.
+    Ran(FinishedRun),
+    /// Another process finished it first.
+    AlreadyFinished,
+    /// Another process is running it.
+    Held(ClaimRecord),
+}
+
+/// Claims the run `key` and, unless another process has finished it
+/// meanwhile, runs it; the claim goes once its files are complete.
+fn claim_and_run(dir: &Path, spec: &GridSpec, key: &RunKey, timeout: Duration) -> Result<Outcome> {
+    let claim = match claim(&run_dir(dir, key), timeout)? {
+        Attempt::Held(record) => return Ok(Outcome::Held(record)),
+        Attempt::Claimed(claim) => claim,
+    };
+    if run_status(dir, spec, key)? == RunStatus::Finished {
+        return Ok(Outcome::AlreadyFinished);
+    }
+    let run = run_one(dir, spec, key)?;
+    drop(claim);
+    Ok(Outcome::Ran(run))
+}
+
+/// Runs every unfinished run of `options.shard` of `spec` in `dir`, on
+/// `options.threads` threads, claiming each run first so that other
+/// processes on the same folder never run it too. Results do not depend on
+/// threads, shards, other processes or interruptions.
+pub fn replicate(
+    dir: &Path,
+    spec: &GridSpec,
+    options: &ReplicateOptions,
+    progress: &dyn GridProgress,
+) -> Result<ReplicateSummary> {
     let clock = Instant::now();
-    let (todo, skipped) = prepare(dir, spec)?;
+    let (todo, skipped) = prepare(dir, spec, options.shard)?;
     progress.start(todo.len() + skipped, skipped);
-    let pool = crate::ode::thread_pool(jobs)?;
+    let pool = crate::ode::thread_pool(options.threads)?;
     let failures = Mutex::new(Vec::new());
+    let held = Mutex::new(Vec::new());
     let ran = AtomicU64::new(0);
+    let finished_elsewhere = AtomicU64::new(0);
+    let lock = "no panics while holding the lock";
     pool.install(|| {
         todo.par_iter()
             .with_max_len(1)
-            .for_each(|key| match run_one(dir, spec, key) {
-                Ok(run) => {
+            .for_each(|key| match claim_and_run(dir, spec, key, options.claim_timeout) {
+                Ok(Outcome::Ran(run)) => {
                     ran.fetch_add(1, Ordering::Relaxed);
                     progress.finished(&run);
                 }
-                Err(e) => failures
-                    .lock()
-                    .expect("no panics while holding the lock")
-                    .push(format!("{e:#}")),
+                Ok(Outcome::AlreadyFinished) => {
+                    finished_elsewhere.fetch_add(1, Ordering::Relaxed);
+                }
+                Ok(Outcome::Held(claim)) => held.lock().expect(lock).push(HeldRun { key: *key, claim }),
+                Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
             })
     });
-    let failures = failures.into_inner().expect("no panics while holding the lock");
+    let failures = failures.into_inner().expect(lock);
     if !failures.is_empty() {
         bail!("{} run(s) failed:\n  {}", failures.len(), failures.join("\n  "));
     }
+    let mut held = held.into_inner().expect(lock);
+    let order = spec.runs();
+    held.sort_by_key(|h| order.iter().position(|k| *k == h.key));
     Ok(ReplicateSummary {
         total: todo.len() + skipped,
-        skipped,
+        skipped: skipped + finished_elsewhere.load(Ordering::Relaxed) as usize,
         ran: ran.load(Ordering::Relaxed) as usize,
+        held,
         seconds: clock.elapsed().as_secs_f64(),
     })
 }

@@ -1,7 +1,7 @@
 //! The replication report: reads a grid directory, puts its results beside
 //! the paper's Tables 1-7 (Welch's test against the baseline, as the paper
 //! does), judges each of the paper's findings by explicit rules, draws the
-//! fitness curves, and writes `report.md` (and `report.csv` or
+//! fitness curves, and writes `report.md`, `runs.csv` (and `report.csv` or
 //! `report.json`) into the grid directory.
 //!
 //! A run counts only when it is finished and all its files parse. Missing
@@ -26,7 +26,9 @@ use serde::{Deserialize, Serialize};
 
 use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
 use super::robustness::Robustness;
+use super::runs_table::{runs_csv, RUNS_CSV};
 use super::GridConfig;
+use crate::physics::BackendKind;
 use crate::psa::Task;
 
 pub use distance::{Distance, Term};
@@ -91,8 +93,14 @@ pub struct BuildRecord {
 #[derive(Debug, Deserialize)]
 struct RunSummary {
     task: Task,
+    #[serde(deserialize_with = "crate::io::u64_string::deserialize")]
+    seed: u64,
+    backend: BackendKind,
     champion_fitness: f64,
+    champion_generation: usize,
+    evaluations: u64,
     bursts: usize,
+    champion_hidden: usize,
     seconds: f64,
     build: BuildRecord,
 }
@@ -117,10 +125,20 @@ pub struct GenerationRow {
 pub struct RunData {
     /// The run.
     pub key: RunKey,
+    /// The seed the run used (`run.json`'s `seed`).
+    pub run_seed: u64,
+    /// Its physics backend.
+    pub backend: BackendKind,
     /// Champion fitness (%).
     pub champion: f64,
+    /// The generation (cycle) the champion was found in.
+    pub champion_generation: usize,
+    /// Network evaluations, lesion tests included.
+    pub evaluations: u64,
     /// Burst mutations.
     pub bursts: usize,
+    /// Hidden neurons of the champion.
+    pub champion_hidden: usize,
     /// Wall-clock seconds.
     pub seconds: f64,
     /// The build that made it.
@@ -263,8 +281,13 @@ fn load_run(folder: &Path, key: &RunKey) -> Result<RunData> {
     let records = parse_records(&text).with_context(|| format!("{}: damaged file", path.display()))?;
     Ok(RunData {
         key: *key,
+        run_seed: summary.seed,
+        backend: summary.backend,
         champion: summary.champion_fitness,
+        champion_generation: summary.champion_generation,
+        evaluations: summary.evaluations,
         bursts: summary.bursts,
+        champion_hidden: summary.champion_hidden,
         seconds: summary.seconds,
         build: summary.build,
         robustness,
@@ -314,7 +337,7 @@ pub fn parse_records(text: &str) -> Result<Vec<GenerationRow>> {
 /// What [`write_report`] did.
 #[derive(Debug, Clone)]
 pub struct ReportOutcome {
-    /// The files written (report.md first, then report.csv or report.json).
+    /// The files written (report.md first, runs.csv, then report.csv or report.json).
     pub written: Vec<PathBuf>,
     /// The figures written (SVG and PNG).
     pub figures: Vec<PathBuf>,
@@ -342,8 +365,9 @@ impl ReportOutcome {
     }
 }
 
-/// Reads the grid in `dir` and writes `report.md`, the figures in
-/// `dir/figures/`, and `report.csv` or `report.json` per `format`.
+/// Reads the grid in `dir` and writes `report.md`, `runs.csv` (one row per
+/// counted run), the figures in `dir/figures/`, and `report.csv` or
+/// `report.json` per `format`.
 ///
 /// Fails when `dir` is not a grid directory or a file cannot be written;
 /// damaged runs and figures that cannot be drawn are reported in the
@@ -357,7 +381,9 @@ pub fn write_report(dir: &Path, format: ReportFormat) -> Result<ReportOutcome> {
     let markdown = render::markdown(&report);
     let md_path = dir.join("report.md");
     crate::io::write_atomic(&md_path, markdown.as_bytes())?;
-    let mut written = vec![md_path];
+    let runs_path = dir.join(RUNS_CSV);
+    crate::io::write_atomic(&runs_path, runs_csv(&results.runs).as_bytes())?;
+    let mut written = vec![md_path, runs_path];
     match format {
         ReportFormat::Md => {}
         ReportFormat::Csv => {

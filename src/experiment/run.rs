@@ -1,6 +1,6 @@
 //! One evolution run, written to its own directory.
 
-use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -42,7 +42,8 @@ impl RunFiles {
 pub struct EvolveOutcome {
     /// The task.
     pub task: Task,
-    /// The seed.
+    /// The seed (written as a string: see [`crate::io::u64_string`]).
+    #[serde(serialize_with = "crate::io::u64_string::serialize")]
     pub seed: u64,
     /// A label for the configuration (the preset's name).
     pub label: String,
@@ -70,35 +71,73 @@ pub struct EvolveOutcome {
     pub seconds: f64,
 }
 
+/// The header line of `records.csv`.
+const RECORDS_HEADER: &str = "generation,min,mean,max,best,champion,evaluations,subpops,burst,bursts,lesion\n";
+
+/// One line of `records.csv`.
+fn record_line(r: &GenerationRecord) -> String {
+    let best = r.best.map_or(String::new(), |b| b.to_string());
+    let lesion = match r.lesion {
+        None => String::new(),
+        Some(crate::evolution::LesionOutcome::Add) => "add".into(),
+        Some(crate::evolution::LesionOutcome::Remove { neuron }) => format!("remove {neuron}"),
+    };
+    format!(
+        "{},{},{},{},{best},{},{},{},{},{},{lesion}\n",
+        r.generation, r.min, r.mean, r.max, r.champion, r.evaluations, r.subpops, r.burst, r.bursts
+    )
+}
+
 /// The records as CSV, one row per generation.
 pub fn records_csv(records: &[GenerationRecord]) -> String {
-    let mut csv = String::from("generation,min,mean,max,best,champion,evaluations,subpops,burst,bursts,lesion\n");
+    let mut csv = String::from(RECORDS_HEADER);
     for r in records {
-        let best = r.best.map_or(String::new(), |b| b.to_string());
-        let lesion = match r.lesion {
-            None => String::new(),
-            Some(crate::evolution::LesionOutcome::Add) => "add".into(),
-            Some(crate::evolution::LesionOutcome::Remove { neuron }) => format!("remove {neuron}"),
-        };
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{best},{},{},{},{},{},{lesion}",
-            r.generation, r.min, r.mean, r.max, r.champion, r.evaluations, r.subpops, r.burst, r.bursts
-        );
+        csv.push_str(&record_line(r));
     }
     csv
 }
 
+/// `records.csv` while the run goes: a line written and flushed per
+/// generation, so that it can be watched (`tail -f`). The finished run
+/// replaces it atomically with the whole file; should a live write fail,
+/// live writing stops and the run goes on.
+struct LiveRecords {
+    file: Option<std::fs::File>,
+}
+
+impl LiveRecords {
+    fn create(path: &Path) -> LiveRecords {
+        let file = std::fs::File::create(path).and_then(|mut f| {
+            f.write_all(RECORDS_HEADER.as_bytes())?;
+            Ok(f)
+        });
+        LiveRecords { file: file.ok() }
+    }
+
+    fn push(&mut self, record: &GenerationRecord) {
+        if let Some(file) = &mut self.file {
+            if file
+                .write_all(record_line(record).as_bytes())
+                .and_then(|_| file.flush())
+                .is_err()
+            {
+                self.file = None;
+            }
+        }
+    }
+}
+
 /// Runs `config` on `task` with `seed` on the current rayon pool and writes
 /// `config.toml`, `records.csv`, `champion.json` and `run.json` (each
-/// atomically) into `dir`. `on_generation` sees every record as it comes.
+/// atomically) into `dir`; `records.csv` also grows a line per generation
+/// while the run goes. `on_generation` sees every record as it comes.
 pub fn run_evolution(
     config: &RunConfig,
     label: &str,
     task: Task,
     seed: u64,
     dir: &Path,
-    on_generation: impl FnMut(&GenerationRecord),
+    mut on_generation: impl FnMut(&GenerationRecord),
 ) -> Result<EvolveOutcome> {
     config.validate()?;
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
@@ -107,6 +146,11 @@ pub fn run_evolution(
     let started = crate::provenance::now_rfc3339();
     let clock = Instant::now();
     let evaluator = PsaEvaluator::new(config.problem.clone(), task)?;
+    let mut live = LiveRecords::create(&files.records);
+    let on_generation = |record: &GenerationRecord| {
+        live.push(record);
+        on_generation(record);
+    };
     let result: RunResult = match config.algorithm {
         Algorithm::Esp => Esp::new(config.esp.clone(), seed)
             .map_err(anyhow::Error::msg)?
@@ -120,7 +164,7 @@ pub fn run_evolution(
     let champion = &result.champion;
     let mut extra = serde_json::Map::new();
     extra.insert("configuration".into(), label.into());
-    extra.insert("seed".into(), seed.into());
+    extra.insert("seed".into(), seed.to_string().into());
     extra.insert("fitness_percent".into(), champion.fitness.into());
     extra.insert("generation".into(), champion.generation.into());
     extra.insert("backend".into(), config.problem.backend.name().into());

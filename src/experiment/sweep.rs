@@ -17,7 +17,7 @@ use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use super::grid::GridSpec;
-use super::replicate::{replicate, GridProgress, ReplicateSummary};
+use super::replicate::{replicate, GridProgress, HeldRun, ReplicateOptions, ReplicateSummary};
 use super::RunConfig;
 
 /// The `format` of `sweep.json`.
@@ -302,13 +302,22 @@ pub struct SweepSummary {
     pub skipped: usize,
     /// Runs done now.
     pub ran: usize,
+    /// Runs other processes were running, left to them (with their variant).
+    pub held: Vec<(String, HeldRun)>,
     /// Wall-clock seconds.
     pub seconds: f64,
 }
 
 /// Runs every variant's grid in `dir` (a new folder gets `sweep.json`; an
 /// existing sweep must have the same definition), variant after variant.
-pub fn sweep(dir: &Path, spec: &SweepSpec, jobs: usize, progress: &dyn GridProgress) -> Result<SweepSummary> {
+/// `options.shard` splits the sweep's whole run order (the variants' run
+/// orders one after another), round-robin as a grid's.
+pub fn sweep(
+    dir: &Path,
+    spec: &SweepSpec,
+    options: &ReplicateOptions,
+    progress: &dyn GridProgress,
+) -> Result<SweepSummary> {
     prepare(dir, spec)?;
     let variants = spec.variants();
     let mut summary = SweepSummary {
@@ -316,45 +325,58 @@ pub fn sweep(dir: &Path, spec: &SweepSpec, jobs: usize, progress: &dyn GridProgr
         total: 0,
         skipped: 0,
         ran: 0,
+        held: Vec::new(),
         seconds: 0.0,
     };
+    let mut before = 0;
     for variant in &variants {
         let grid = spec.variant_grid(variant)?;
+        let variant_options = ReplicateOptions {
+            shard: options.shard.after(before),
+            ..*options
+        };
+        before += grid.runs().len();
         let ReplicateSummary {
             total,
             skipped,
             ran,
+            held,
             seconds,
-        } = replicate(&variant_dir(dir, variant), &grid, jobs, progress)
+        } = replicate(&variant_dir(dir, variant), &grid, &variant_options, progress)
             .with_context(|| format!("variant {}", variant.name))?;
         summary.total += total;
         summary.skipped += skipped;
         summary.ran += ran;
+        summary.held.extend(held.into_iter().map(|h| (variant.name.clone(), h)));
         summary.seconds += seconds;
     }
     Ok(summary)
 }
 
-/// Creates `dir` with `sweep.json`, or checks that it holds the same sweep.
+/// Creates `dir` with `sweep.json` (of processes starting together,
+/// exactly one writes it), or checks that it holds the same sweep.
 fn prepare(dir: &Path, spec: &SweepSpec) -> Result<()> {
-    if sweep_file(dir).exists() {
-        let existing = SweepSpec::load(dir)?;
-        if existing != *spec {
-            bail!(
-                "{} holds a sweep with another definition; resume it with the same options or use another --out",
-                dir.display()
-            );
-        }
-        return Ok(());
-    }
-    if dir.exists() && dir.read_dir().is_ok_and(|mut d| d.next().is_some()) {
+    // The folder's contents first: they appear only after its sweep.json.
+    if dir.read_dir().is_ok_and(|mut d| d.next().is_some()) && !sweep_file(dir).exists() {
         bail!(
             "{} exists and is not a sweep folder (no sweep.json); use another --out",
             dir.display()
         );
     }
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    spec.save(dir)
+    let mut json = serde_json::to_string_pretty(spec)?;
+    json.push('\n');
+    if !sweep_file(dir).exists() && crate::io::create_new_atomic(&sweep_file(dir), json.as_bytes())? {
+        return Ok(());
+    }
+    let existing = SweepSpec::load(dir)?;
+    if existing != *spec {
+        bail!(
+            "{} holds a sweep with another definition; resume it with the same options or use another --out",
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 #[cfg(test)]

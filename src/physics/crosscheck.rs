@@ -109,7 +109,8 @@ pub struct CrosscheckReport {
     pub sequences: usize,
     /// Steps per sequence.
     pub steps: usize,
-    /// Seed of the sequences.
+    /// Seed of the sequences (a string in JSON: see [`crate::io::u64_string`]).
+    #[serde(serialize_with = "crate::io::u64_string::serialize")]
     pub seed: u64,
     /// One entry per backend other than `ode`.
     pub comparisons: Vec<BackendComparison>,

@@ -126,17 +126,12 @@ fn banners(md: &mut String, report: &Report) {
 
 fn grid_section(md: &mut String, report: &Report) {
     let g = &report.grid;
-    let paper = GridSpec::from_preset(GridPreset::Paper);
     let configs: Vec<&str> = g.configs.iter().map(|c| c.name()).collect();
     let tasks: Vec<String> = g.tasks.iter().map(|t| t.to_string()).collect();
     md.push_str("## Grid\n\n| | |\n|---|---|\n");
     let preset = serde_json::to_value(g.preset).ok();
     let preset = preset.as_ref().and_then(|v| v.as_str()).unwrap_or("?");
-    let backend = if g.backend == paper.backend {
-        g.backend.to_string()
-    } else {
-        format!("{} (the paper protocol uses {})", g.backend, paper.backend)
-    };
+    let backend = g.backend.to_string();
     let rows = [
         ("preset", preset.to_string()),
         ("configurations", configs.join(", ")),
