@@ -157,5 +157,19 @@ fn a_slurm_job_array_gives_the_single_process_grid() {
     assert_eq!(ran.len(), 3, "each run by exactly one shard: {ran:?}");
     assert!(grid.join("report.md").exists() && grid.join("runs.csv").exists());
     assert_same_runs(&single, &grid);
+
+    // A failing shard: the report job is cancelled and submit.sh says so.
+    let o = Command::new(script("submit.sh"))
+        .args(["--wait", "2", "replicate", "--generations", "0", "--out"])
+        .arg(tmp.path().join("failing"))
+        .current_dir(&jobs)
+        .env("SLURM_CONF", &cluster.conf)
+        .env("PSA_ESP", env!("CARGO_BIN_EXE_psa-esp"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("JobState=CANCELLED"), "{stdout}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("did not complete"));
     drop(cluster);
 }

@@ -46,8 +46,19 @@ echo "submitted job array $array: $shards shards of the grid in $out"
 status=0
 report=$(sbatch --parsable "${wait[@]}" --dependency="afterok:$array" --kill-on-invalid-dep=yes \
     "$here/report.sbatch" "$out") || status=$?
+if [ -z "$report" ]; then
+    echo "could not submit the report job; the array $array runs on (submit scripts/slurm/report.sbatch $out by hand)" >&2
+    exit "$status"
+fi
 echo "submitted report job ${report%%;*} (after the array succeeds): $out/report.md, $out/runs.csv"
 if [ ${#wait[@]} -gt 0 ]; then
-    echo "report job ended with exit status $status"
+    # A report job cancelled because a shard failed ends sbatch --wait with
+    # status 0: its state tells.
+    state=$(scontrol show job "${report%%;*}" -o 2>/dev/null | grep -o 'JobState=[A-Z_]*' || true)
+    echo "report job ended: ${state:-JobState=unknown}, exit status $status"
+    if [ "$state" != JobState=COMPLETED ] && [ "$status" -eq 0 ]; then
+        echo "the grid did not complete: see the shards' logs (psa-esp-${array}_*.out)" >&2
+        status=1
+    fi
 fi
 exit "$status"
