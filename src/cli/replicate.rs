@@ -8,7 +8,8 @@ use anyhow::Result;
 use super::evolve::progress_bar;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
-use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress};
+use crate::experiment::lockstep::Executor;
+use crate::experiment::replicate::{describe, replicate_with, FinishedRun, GridProgress};
 use crate::experiment::GridConfig;
 use crate::ode::MAX_THREADS;
 use crate::physics::BackendKind;
@@ -60,9 +61,23 @@ pub struct GridArgs {
     /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
     pub jobs: u64,
+    /// Advance all runs together, a generation per round, each round's
+    /// networks of every run evaluated as one batch (for evaluators that
+    /// gain from large batches). Results do not depend on it.
+    #[arg(long)]
+    pub lockstep: bool,
 }
 
 impl GridArgs {
+    /// The executor these options ask for.
+    pub fn executor(&self) -> Executor {
+        if self.lockstep {
+            Executor::Lockstep
+        } else {
+            Executor::RunByRun
+        }
+    }
+
     /// The grid these options describe.
     pub fn spec(&self) -> Result<GridSpec> {
         let mut spec = GridSpec::from_preset(self.preset);
@@ -140,7 +155,13 @@ impl GridProgress for Progress {
 pub fn run(args: ReplicateArgs) -> Result<i32> {
     let spec = args.grid.spec()?;
     let progress = Progress::new();
-    let summary = replicate(&args.out, &spec, args.grid.jobs as usize, &progress)?;
+    let summary = replicate_with(
+        &args.out,
+        &spec,
+        args.grid.jobs as usize,
+        args.grid.executor(),
+        &progress,
+    )?;
     progress.bar.finish_and_clear();
     say!(
         "grid {} ({}): {} runs, {} already finished, {} run now in {:.0} s",

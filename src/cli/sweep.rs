@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use super::replicate::{GridArgs, Progress};
-use crate::experiment::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
+use crate::experiment::sweep::{parse_vary, sweep_with, SweepMode, SweepSpec};
 
 /// Arguments of `sweep`.
 #[derive(Debug, clap::Args)]
@@ -32,7 +32,13 @@ pub fn run(args: SweepArgs) -> Result<i32> {
     let vary = args.vary.iter().map(|v| parse_vary(v)).collect::<Result<Vec<_>>>()?;
     let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
     let progress = Progress::new();
-    let summary = sweep(&args.out, &spec, args.grid.jobs as usize, &progress)?;
+    let summary = sweep_with(
+        &args.out,
+        &spec,
+        args.grid.jobs as usize,
+        args.grid.executor(),
+        &progress,
+    )?;
     progress.bar.finish_and_clear();
     say!(
         "sweep {}: {} variants, {} runs, {} already finished, {} run now in {:.0} s",

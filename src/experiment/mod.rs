@@ -4,6 +4,7 @@
 mod config;
 mod evaluator;
 pub mod grid;
+pub mod lockstep;
 pub mod replicate;
 pub mod report;
 pub mod robustness;
@@ -14,4 +15,4 @@ pub mod sweep;
 pub use config::{paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};
 pub use evaluator::{PsaEvaluator, PsaWorker, SIMD_VARIABLE};
 pub use report::{write_report, ReportFormat, ReportOutcome};
-pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles};
+pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles, RunStart};

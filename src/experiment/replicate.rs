@@ -12,6 +12,7 @@ use rand::RngExt;
 use rayon::prelude::*;
 
 use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
+use super::lockstep::{replicate_lockstep, Executor};
 use super::robustness::test_robustness;
 use super::{run_evolution, EvolveOutcome};
 use crate::psa::NetworkFile;
@@ -129,8 +130,22 @@ pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun>
     let seed = run_seed(key);
     let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, |_| {})
         .with_context(|| format!("run {}", folder.display()))?;
+    test_and_mark(dir, spec, key, outcome)
+}
+
+/// A run's robustness tests, once its evolution is written; writes
+/// `robustness.json`, which marks it finished.
+pub(super) fn test_and_mark(dir: &Path, spec: &GridSpec, key: &RunKey, outcome: EvolveOutcome) -> Result<FinishedRun> {
+    let folder = run_dir(dir, key);
+    let config = spec.run_config(key.config)?;
     let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
-    let robustness = test_robustness(&champion, key.task, &config.problem, spec.robustness_trials, seed)?;
+    let robustness = test_robustness(
+        &champion,
+        key.task,
+        &config.problem,
+        spec.robustness_trials,
+        outcome.seed,
+    )?;
     let mut json = serde_json::to_string_pretty(&robustness)?;
     json.push('\n');
     crate::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())?;
@@ -140,25 +155,40 @@ pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun>
 /// Runs every unfinished run of `spec` in `dir` on `jobs` threads (0 = one
 /// per core). Results do not depend on `jobs` or on interruptions.
 pub fn replicate(dir: &Path, spec: &GridSpec, jobs: usize, progress: &dyn GridProgress) -> Result<ReplicateSummary> {
+    replicate_with(dir, spec, jobs, Executor::RunByRun, progress)
+}
+
+/// [`replicate`] with the runs advanced by `executor`; results do not
+/// depend on it.
+pub fn replicate_with(
+    dir: &Path,
+    spec: &GridSpec,
+    jobs: usize,
+    executor: Executor,
+    progress: &dyn GridProgress,
+) -> Result<ReplicateSummary> {
     let clock = Instant::now();
     let (todo, skipped) = prepare(dir, spec)?;
     progress.start(todo.len() + skipped, skipped);
     let pool = crate::ode::thread_pool(jobs)?;
     let failures = Mutex::new(Vec::new());
     let ran = AtomicU64::new(0);
-    pool.install(|| {
-        todo.par_iter()
+    let finished = |result: Result<FinishedRun>| match result {
+        Ok(run) => {
+            ran.fetch_add(1, Ordering::Relaxed);
+            progress.finished(&run);
+        }
+        Err(e) => failures
+            .lock()
+            .expect("no panics while holding the lock")
+            .push(format!("{e:#}")),
+    };
+    pool.install(|| match executor {
+        Executor::Lockstep => replicate_lockstep(dir, spec, &todo, &finished),
+        Executor::RunByRun => todo
+            .par_iter()
             .with_max_len(1)
-            .for_each(|key| match run_one(dir, spec, key) {
-                Ok(run) => {
-                    ran.fetch_add(1, Ordering::Relaxed);
-                    progress.finished(&run);
-                }
-                Err(e) => failures
-                    .lock()
-                    .expect("no panics while holding the lock")
-                    .push(format!("{e:#}")),
-            })
+            .for_each(|key| finished(run_one(dir, spec, key))),
     });
     let failures = failures.into_inner().expect("no panics while holding the lock");
     if !failures.is_empty() {

@@ -17,7 +17,8 @@ use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use super::grid::GridSpec;
-use super::replicate::{replicate, GridProgress, ReplicateSummary};
+use super::lockstep::Executor;
+use super::replicate::{replicate_with, GridProgress, ReplicateSummary};
 use super::RunConfig;
 
 /// The `format` of `sweep.json`.
@@ -309,6 +310,18 @@ pub struct SweepSummary {
 /// Runs every variant's grid in `dir` (a new folder gets `sweep.json`; an
 /// existing sweep must have the same definition), variant after variant.
 pub fn sweep(dir: &Path, spec: &SweepSpec, jobs: usize, progress: &dyn GridProgress) -> Result<SweepSummary> {
+    sweep_with(dir, spec, jobs, Executor::RunByRun, progress)
+}
+
+/// [`sweep`] with each variant's runs advanced by `executor`; results do
+/// not depend on it.
+pub fn sweep_with(
+    dir: &Path,
+    spec: &SweepSpec,
+    jobs: usize,
+    executor: Executor,
+    progress: &dyn GridProgress,
+) -> Result<SweepSummary> {
     prepare(dir, spec)?;
     let variants = spec.variants();
     let mut summary = SweepSummary {
@@ -325,7 +338,7 @@ pub fn sweep(dir: &Path, spec: &SweepSpec, jobs: usize, progress: &dyn GridProgr
             skipped,
             ran,
             seconds,
-        } = replicate(&variant_dir(dir, variant), &grid, jobs, progress)
+        } = replicate_with(&variant_dir(dir, variant), &grid, jobs, executor, progress)
             .with_context(|| format!("variant {}", variant.name))?;
         summary.total += total;
         summary.skipped += skipped;
