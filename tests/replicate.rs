@@ -112,6 +112,76 @@ fn a_grid_killed_part_way_resumes_to_the_same_results() {
     );
 }
 
+/// Every run's `run.json` without its times (started, finished, seconds).
+fn summaries(dir: &Path) -> Vec<(String, serde_json::Value)> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.join("runs")];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.ends_with("run.json") {
+                let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+                for time in ["started", "finished", "seconds"] {
+                    json.as_object_mut()
+                        .unwrap()
+                        .remove(time)
+                        .expect("run.json has its times");
+                }
+                files.push((path.strip_prefix(dir).unwrap().display().to_string(), json));
+            }
+        }
+    }
+    files.sort_by(|a, b| a.0.cmp(&b.0));
+    files
+}
+
+#[test]
+fn a_grid_in_lockstep_writes_the_files_of_run_by_run_byte_for_byte() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (apart, together) = (tmp.path().join("apart"), tmp.path().join("together"));
+    // ESP, the hill-climber, input noise and random starts (both draw from the
+    // evaluation streams), on task 1.
+    let args = |out: &Path, lockstep: bool| {
+        let mut args: Vec<String> = [
+            "replicate",
+            "--configs",
+            "baseline,gomez,hill-climb,input-noise,random-init",
+            "--tasks",
+            "1",
+            "--seeds",
+            "2",
+            "--generations",
+            "30",
+            "--robustness-trials",
+            "10",
+            "--out",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([out.to_str().unwrap().to_string()])
+        .collect();
+        if lockstep {
+            args.extend(["--lockstep".into(), "--jobs".into(), "2".into()]);
+        } else {
+            args.extend(["--jobs".into(), "1".into()]);
+        }
+        args
+    };
+    for (dir, lockstep) in [(&apart, false), (&together, true)] {
+        let o = psa_esp(&args(dir, lockstep).iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(finished_runs(dir), 10);
+    }
+    assert!(
+        results(&apart) == results(&together),
+        "lockstep grid differs from the run-by-run one"
+    );
+    assert_eq!(summaries(&apart), summaries(&together));
+    assert_eq!(summaries(&apart).len(), 10);
+}
+
 #[test]
 fn damaged_or_foreign_run_folders_are_reported_and_left_untouched() {
     let tmp = tempfile::tempdir().unwrap();

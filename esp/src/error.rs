@@ -115,7 +115,22 @@ pub enum RunError {
         /// The weight.
         value: f64,
     },
-    /// The hill-climber made a network that is not valid (a weight overflowed).
+    /// The hill-climber made a network that is not valid (a weight
+    /// overflowed), or a run was started on networks of no inputs or outputs.
     #[error(transparent)]
     Network(#[from] NetworkError),
+    /// A run was told another number of fitnesses than it asked networks.
+    #[error("told {got} fitnesses for the {expected} networks asked")]
+    FitnessCount {
+        /// Networks asked.
+        expected: usize,
+        /// Fitnesses told.
+        got: usize,
+    },
+    /// A run was told fitnesses after it had ended.
+    #[error("the run has ended: it asks for no more networks")]
+    Ended,
+    /// A run's result was asked for before it ended.
+    #[error("the run has not ended: it still asks for networks")]
+    NotEnded,
 }

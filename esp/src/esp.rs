@@ -7,17 +7,22 @@ use rand::seq::SliceRandom;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
+use super::ask::{drive, AskPurpose, Asked, Networks};
+use super::esp_run::EspRun;
+use super::network::check_sizes;
 use super::operators::{cauchy, crossover, mutate_one_gene};
 use super::subpop::Subpop;
 use super::{
-    best_of, check_cauchy_limit, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
-    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_SUBPOP_SIZE, MAX_TRIALS_PER_NEURON, RECORDS_RESERVED,
+    best_of, check_cauchy_limit, check_count, check_positive, check_probability, min_and_mean, purpose,
+    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_SUBPOP_SIZE, MAX_TRIALS_PER_NEURON,
 };
 use super::{
-    Champion, Control, Ending, Evaluator, GenerationRecord, LesionOutcome, RunError, RunResult, SettingsError, StopAt,
+    Champion, Control, Evaluator, GenerationRecord, LesionOutcome, RunError, RunResult, SettingsError, StopAt,
 };
 use crate::network::{Network, NetworkSet};
 use crate::rng::stream;
+#[cfg(test)]
+use crate::Ending;
 
 /// How networks are formed from the sub-populations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -229,14 +234,14 @@ pub struct Esp {
 }
 
 /// The search's state between generations.
-struct State {
+pub(crate) struct State {
     inputs: usize,
     outputs: usize,
     /// The sub-populations, one per hidden neuron.
     subpops: Vec<Subpop>,
     /// The search's best network and its fitness (what burst mutation builds on).
     best: Option<(Network, f64)>,
-    champion: Option<Champion>,
+    pub(crate) champion: Option<Champion>,
     /// Generations without improvement, as the stagnation rule counts them.
     since_improvement: usize,
     /// The best network fitness since the phase began (the last burst
@@ -282,18 +287,24 @@ impl State {
                 });
             }
         }
-        Ok(Assembled {
+        Ok(self.assembled(picks))
+    }
+
+    /// The networks `picks` form, unchecked (checked by
+    /// [`State::networks`] when the picks were made).
+    fn assembled<'a>(&'a self, picks: &'a Picks) -> Assembled<'a> {
+        Assembled {
             inputs: self.inputs,
             outputs: self.outputs,
             subpops: &self.subpops,
             picks,
-        })
+        }
     }
 }
 
 /// A generation's networks as its sub-populations and picks: what the
 /// evaluator reads, neuron by neuron, without a copy of each network.
-struct Assembled<'a> {
+pub(crate) struct Assembled<'a> {
     inputs: usize,
     outputs: usize,
     subpops: &'a [Subpop],
@@ -331,7 +342,7 @@ impl NetworkSet for Assembled<'_> {
 /// Which neuron of each sub-population every network of a generation
 /// takes, network after network in one flat list: network j takes neuron
 /// `flat[j * subpops + i]` of sub-population i.
-struct Picks {
+pub(crate) struct Picks {
     subpops: usize,
     flat: Vec<usize>,
 }
@@ -346,6 +357,45 @@ impl Picks {
     fn networks(&self) -> std::slice::ChunksExact<'_, usize> {
         self.flat.chunks_exact(self.subpops)
     }
+}
+
+/// Where a generation stands while its networks are out for evaluation.
+pub(crate) enum Step {
+    /// The generation's networks are asked.
+    Evaluate(Picks),
+    /// A lesion test's networks are asked: before the burst mutation
+    /// (`before_burst`) or after discard-all rebuilt the sub-populations.
+    Lesion {
+        variants: Vec<Network>,
+        before_burst: bool,
+        stats: Stats,
+    },
+}
+
+impl Step {
+    /// The number of networks asked.
+    pub(crate) fn count(&self) -> usize {
+        match self {
+            Step::Evaluate(picks) => picks.count(),
+            Step::Lesion { variants, .. } => variants.len(),
+        }
+    }
+}
+
+/// A generation's fitness statistics, kept for its record while its
+/// lesion tests run.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Stats {
+    min: f64,
+    mean: f64,
+    max: f64,
+}
+
+/// What a generation needs after a step: more networks evaluated, or
+/// nothing (its record).
+pub(crate) enum Advance {
+    Ask(Step),
+    Record(GenerationRecord),
 }
 
 impl Esp {
@@ -369,40 +419,42 @@ impl Esp {
         &self.settings
     }
 
+    /// The seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// When the run ends early.
+    pub fn stop(&self) -> StopAt {
+        self.stop
+    }
+
+    /// Starts the run on networks of `inputs` inputs (the bias included)
+    /// and `outputs` outputs, to be driven by ask and tell ([`AskTell`](crate::AskTell)).
+    /// Fails on a size of 0.
+    pub fn start(&self, inputs: usize, outputs: usize) -> Result<EspRun, RunError> {
+        check_sizes(inputs, outputs)?;
+        let s = &self.settings;
+        let mut rng = stream(self.seed, &[purpose::INIT]);
+        let subpops = (0..s.initial_hidden)
+            .map(|_| Subpop::random(&mut rng, s.subpop_size, inputs + outputs, s.init_range))
+            .collect();
+        Ok(EspRun::new(self.clone(), State::new(inputs, outputs, subpops)))
+    }
+
     /// Runs the generations on the current rayon pool, calling
     /// `on_generation` after each, until the last, or until the stop
     /// conditions ([`Esp::stop_at`]) or `on_generation` (returning
-    /// [`Control::Stop`]) end the run.
+    /// [`Control::Stop`]) end the run. A loop over [`Esp::start`]'s ask,
+    /// evaluate and tell.
     pub fn run<E: Evaluator, C: Into<Control>>(
         &self,
         evaluator: &E,
-        mut on_generation: impl FnMut(&GenerationRecord) -> C,
+        on_generation: impl FnMut(&GenerationRecord) -> C,
     ) -> Result<RunResult, RunError> {
-        let s = &self.settings;
-        let (inputs, outputs) = (evaluator.inputs(), evaluator.outputs());
-        let genes = inputs + outputs;
-        let mut rng = stream(self.seed, &[purpose::INIT]);
-        let subpops = (0..s.initial_hidden)
-            .map(|_| Subpop::random(&mut rng, s.subpop_size, genes, s.init_range))
-            .collect();
-        let mut state = State::new(inputs, outputs, subpops);
-        let mut records = Vec::with_capacity(s.generations.min(RECORDS_RESERVED));
-        let mut ending = Ending::Completed;
-        for generation in 1..=s.generations {
-            let record = self.generation(evaluator, &mut state, generation)?;
-            let decision = self.stop.decide(&record, on_generation(&record).into());
-            records.push(record);
-            if let Some(end) = decision {
-                ending = end;
-                break;
-            }
-        }
-        let champion = state.champion.expect("every generation has a champion");
-        Ok(RunResult {
-            champion,
-            records,
-            ending,
-        })
+        let mut run = self.start(evaluator.inputs(), evaluator.outputs())?;
+        drive(&mut run, evaluator, on_generation)?;
+        run.into_result()
     }
 
     /// Which neuron of each sub-population every network takes.
@@ -433,40 +485,70 @@ impl Esp {
         Picks { subpops, flat: picks }
     }
 
-    fn generation<E: Evaluator>(
-        &self,
-        evaluator: &E,
-        state: &mut State,
-        generation: usize,
-    ) -> Result<GenerationRecord, RunError> {
+    /// Generation `generation`'s first step: its networks; fails if a
+    /// weight of any sub-population is not finite.
+    pub(crate) fn begin(&self, state: &State, generation: usize) -> Result<Step, RunError> {
         let picks = self.sample(generation, state.subpops.len());
-        let networks = state.networks(&picks)?;
-        let fitness = evaluate_all(evaluator, &networks, self.seed, &[purpose::EVALUATE, generation as u64])?;
-        let (top, top_fitness) = best_of(&fitness);
-        let top_evaluation = state.evaluations + top as u64 + 1;
-        let top = networks.network(top).into_owned();
-        self.conclude(
-            evaluator,
-            state,
-            &picks,
-            fitness,
-            (top, top_fitness, top_evaluation),
-            generation,
-        )
+        state.networks(&picks)?;
+        Ok(Step::Evaluate(picks))
+    }
+
+    /// The networks `step` asks for, with their streams.
+    pub(crate) fn asked<'a>(&self, state: &'a State, step: &'a Step, generation: usize) -> Asked<'a> {
+        let g = generation as u64;
+        match step {
+            Step::Evaluate(picks) => Asked::new(
+                Networks::Set(state.assembled(picks)),
+                AskPurpose::Generation(generation),
+                self.seed,
+                [purpose::EVALUATE, g],
+            ),
+            Step::Lesion { variants, .. } => Asked::new(
+                Networks::List(variants),
+                AskPurpose::LesionTest(generation),
+                self.seed,
+                [purpose::LESION, g],
+            ),
+        }
+    }
+
+    /// The generation after `step`'s networks scored `fitness` (as many,
+    /// none NaN).
+    pub(crate) fn advance(&self, state: &mut State, step: Step, fitness: &[f64], generation: usize) -> Advance {
+        match step {
+            Step::Evaluate(picks) => {
+                let (top, top_fitness) = best_of(fitness);
+                let top_evaluation = state.evaluations + top as u64 + 1;
+                let top = state.assembled(&picks).network(top).into_owned();
+                self.conclude_step(state, &picks, fitness, (top, top_fitness, top_evaluation), generation)
+            }
+            Step::Lesion {
+                variants,
+                before_burst,
+                stats,
+            } => {
+                let outcome = self.judge_lesion(state, &variants, fitness);
+                if before_burst {
+                    self.burst(state, Some(outcome), stats, generation)
+                } else {
+                    Advance::Record(self.after_burst(state, Some(outcome), stats, generation))
+                }
+            }
+        }
     }
 
     /// The generation after its evaluation, given its best network, that
     /// network's fitness and evaluation number: champion and best, then
-    /// burst mutation or credit and recombination; returns its record.
-    fn conclude<E: Evaluator>(
+    /// burst mutation (which may first ask for a lesion test) or credit and
+    /// recombination.
+    fn conclude_step(
         &self,
-        evaluator: &E,
         state: &mut State,
         picks: &Picks,
-        fitness: Vec<f64>,
+        fitness: &[f64],
         (top, top_fitness, top_evaluation): (Network, f64, u64),
         generation: usize,
-    ) -> Result<GenerationRecord, RunError> {
+    ) -> Advance {
         let s = &self.settings;
         state.evaluations += picks.count() as u64;
 
@@ -496,25 +578,38 @@ impl Esp {
             state.since_improvement += 1;
         }
 
-        let mut burst = false;
-        let mut lesion = None;
-        if state.since_improvement >= s.stagnation {
-            state.since_improvement = 0;
-            state.phase_best = f64::NEG_INFINITY;
-            burst = true;
-            lesion = self.stagnate(evaluator, state, generation)?;
-        } else {
-            self.assign_credit(state, picks, &fitness);
-            for (i, subpop) in state.subpops.iter_mut().enumerate() {
-                self.recombine(subpop, generation, i);
-            }
-        }
-        let (min, mean) = min_and_mean(&fitness);
-        Ok(GenerationRecord {
-            generation,
+        let (min, mean) = min_and_mean(fitness);
+        let stats = Stats {
             min,
             mean,
             max: top_fitness,
+        };
+        if state.since_improvement >= s.stagnation {
+            state.since_improvement = 0;
+            state.phase_best = f64::NEG_INFINITY;
+            return self.stagnate_step(state, stats, generation);
+        }
+        self.assign_credit(state, picks, fitness);
+        for (i, subpop) in state.subpops.iter_mut().enumerate() {
+            self.recombine(subpop, generation, i);
+        }
+        Advance::Record(self.record(state, stats, generation, false, None))
+    }
+
+    /// The generation's record.
+    fn record(
+        &self,
+        state: &State,
+        stats: Stats,
+        generation: usize,
+        burst: bool,
+        lesion: Option<LesionOutcome>,
+    ) -> GenerationRecord {
+        GenerationRecord {
+            generation,
+            min: stats.min,
+            mean: stats.mean,
+            max: stats.max,
             best: state.best.as_ref().map(|(_, f)| *f),
             champion: state.champion.as_ref().map_or(f64::NAN, |c| c.fitness),
             evaluations: state.evaluations,
@@ -522,7 +617,7 @@ impl Esp {
             burst,
             bursts: state.bursts,
             lesion,
-        })
+        }
     }
 
     /// Neuron fitness from the networks' (0 for a neuron in no network),
@@ -587,21 +682,25 @@ impl Esp {
         }
     }
 
-    /// Stagnation: a lesion test when bursts have failed often enough, and a
-    /// burst mutation. Returns the lesion outcome applied, if any.
-    fn stagnate<E: Evaluator>(
-        &self,
-        evaluator: &E,
-        state: &mut State,
-        generation: usize,
-    ) -> Result<Option<LesionOutcome>, RunError> {
+    /// Stagnation: a lesion test when bursts have failed often enough
+    /// (asked first), then a burst mutation.
+    fn stagnate_step(&self, state: &mut State, stats: Stats, generation: usize) -> Advance {
         let s = &self.settings;
-        let lesion_on = s.topology == TopologyMode::Lesion;
-        let mut outcome = None;
-        if lesion_on && state.bursts_since_improvement >= s.bursts_before_lesion {
+        if s.topology == TopologyMode::Lesion && state.bursts_since_improvement >= s.bursts_before_lesion {
             state.bursts_since_improvement = 0;
-            outcome = Some(self.lesion_test(evaluator, state, generation)?);
+            return Advance::Ask(Step::Lesion {
+                variants: lesion_variants(state),
+                before_burst: true,
+                stats,
+            });
         }
+        self.burst(state, None, stats, generation)
+    }
+
+    /// Burst mutation, after the lesion test that gave `outcome`, if any;
+    /// discard-all with a pending change asks for a new lesion test first.
+    fn burst(&self, state: &mut State, outcome: Option<LesionOutcome>, stats: Stats, generation: usize) -> Advance {
+        let s = &self.settings;
         let (best, _) = state
             .best
             .clone()
@@ -621,22 +720,39 @@ impl Esp {
                 state.subpops = (0..best.hidden())
                     .map(|k| self.around(best.neuron(k), &mut rng))
                     .collect();
-                if outcome.is_none() && lesion_on && state.pending.is_some() {
+                if outcome.is_none() && s.topology == TopologyMode::Lesion && state.pending.is_some() {
                     // The pending change is decided again by a new lesion test.
-                    outcome = Some(self.lesion_test(evaluator, state, generation)?);
-                }
-                if let Some(change) = outcome {
-                    state.pending = Some(change);
-                    self.apply_change(state, change, generation, false);
+                    return Advance::Ask(Step::Lesion {
+                        variants: lesion_variants(state),
+                        before_burst: false,
+                        stats,
+                    });
                 }
             }
+        }
+        Advance::Record(self.after_burst(state, outcome, stats, generation))
+    }
+
+    /// The end of a burst mutation: discard-all's topology change, erasing
+    /// the best, the counts; returns the generation's record.
+    fn after_burst(
+        &self,
+        state: &mut State,
+        outcome: Option<LesionOutcome>,
+        stats: Stats,
+        generation: usize,
+    ) -> GenerationRecord {
+        let s = &self.settings;
+        if let (BurstMode::DiscardAll, Some(change)) = (s.burst, outcome) {
+            state.pending = Some(change);
+            self.apply_change(state, change, generation, false);
         }
         if outcome.is_some() && s.erase_best {
             state.best = None;
         }
         state.bursts += 1;
         state.bursts_since_improvement += 1;
-        Ok(outcome)
+        self.record(state, stats, generation, true, outcome)
     }
 
     /// A sub-population of copies of `neuron`, Cauchy noise on every gene.
@@ -651,41 +767,20 @@ impl Esp {
         Subpop::from_neurons(neuron.len(), copies)
     }
 
-    /// Evaluates the best network whole and with each hidden neuron
-    /// lesioned: a neuron is redundant when the network keeps
-    /// `lesion_threshold` of its fitness without it.
-    fn lesion_test<E: Evaluator>(
-        &self,
-        evaluator: &E,
-        state: &mut State,
-        generation: usize,
-    ) -> Result<LesionOutcome, RunError> {
-        let (best, _) = state
-            .best
-            .as_ref()
-            .expect("the search has a best network when it stagnates");
-        let mut variants = vec![best.clone()];
-        for k in 0..best.hidden() {
-            let mut lesioned = best.clone();
-            lesioned.set_lesioned(k, true);
-            variants.push(lesioned);
-        }
-        let fitness = evaluate_all(
-            evaluator,
-            &variants[..],
-            self.seed,
-            &[purpose::LESION, generation as u64],
-        )?;
+    /// A lesion test's verdict from the fitness of [`lesion_variants`]: a
+    /// neuron is redundant when the network keeps `lesion_threshold` of its
+    /// fitness without it. Counts the evaluations.
+    fn judge_lesion(&self, state: &mut State, variants: &[Network], fitness: &[f64]) -> LesionOutcome {
         state.evaluations += variants.len() as u64;
         let whole = fitness[0];
         let (neuron, kept) = best_of(&fitness[1..]);
         // For positive fitness this is kept >= threshold x whole.
         let redundant = kept >= whole - (1.0 - self.settings.lesion_threshold) * whole.abs();
-        Ok(if best.hidden() > 1 && redundant {
+        if variants[0].hidden() > 1 && redundant {
             LesionOutcome::Remove { neuron }
         } else {
             LesionOutcome::Add
-        })
+        }
     }
 
     /// Adds a sub-population of random neurons, or removes one. In Gomez's
@@ -715,6 +810,107 @@ impl Esp {
             }
         }
     }
+
+    /// Steps generation `generation` on from `advance` with `evaluator`
+    /// until its record.
+    #[cfg(test)]
+    fn finish<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        mut advance: Advance,
+        generation: usize,
+    ) -> Result<GenerationRecord, RunError> {
+        loop {
+            match advance {
+                Advance::Record(record) => return Ok(record),
+                Advance::Ask(step) => {
+                    let fitness = self.asked(state, &step, generation).evaluate(evaluator)?;
+                    advance = self.advance(state, step, &fitness, generation);
+                }
+            }
+        }
+    }
+
+    /// A whole generation with `evaluator`.
+    #[cfg(test)]
+    fn generation<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        generation: usize,
+    ) -> Result<GenerationRecord, RunError> {
+        let step = self.begin(state, generation)?;
+        self.finish(evaluator, state, Advance::Ask(step), generation)
+    }
+
+    /// The generation after its evaluation (see [`Esp::conclude_step`]),
+    /// its lesion tests evaluated with `evaluator`.
+    #[cfg(test)]
+    fn conclude<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        picks: &Picks,
+        fitness: Vec<f64>,
+        top: (Network, f64, u64),
+        generation: usize,
+    ) -> Result<GenerationRecord, RunError> {
+        let advance = self.conclude_step(state, picks, &fitness, top, generation);
+        self.finish(evaluator, state, advance, generation)
+    }
+
+    /// Stagnation with `evaluator` for its lesion tests; returns the lesion
+    /// outcome applied, if any.
+    #[cfg(test)]
+    fn stagnate<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        generation: usize,
+    ) -> Result<Option<LesionOutcome>, RunError> {
+        let stats = Stats {
+            min: 0.0,
+            mean: 0.0,
+            max: 0.0,
+        };
+        let advance = self.stagnate_step(state, stats, generation);
+        Ok(self.finish(evaluator, state, advance, generation)?.lesion)
+    }
+
+    /// A lesion test of the search's best network with `evaluator`.
+    #[cfg(test)]
+    fn lesion_test<E: Evaluator>(
+        &self,
+        evaluator: &E,
+        state: &mut State,
+        generation: usize,
+    ) -> Result<LesionOutcome, RunError> {
+        let variants = lesion_variants(state);
+        let fitness = crate::evaluate_all(
+            evaluator,
+            &variants[..],
+            self.seed,
+            &[purpose::LESION, generation as u64],
+        )?;
+        Ok(self.judge_lesion(state, &variants, &fitness))
+    }
+}
+
+/// The networks of a lesion test: the search's best network whole, then
+/// with each hidden neuron lesioned in turn.
+fn lesion_variants(state: &State) -> Vec<Network> {
+    let (best, _) = state
+        .best
+        .as_ref()
+        .expect("the search has a best network when it stagnates");
+    let mut variants = vec![best.clone()];
+    for k in 0..best.hidden() {
+        let mut lesioned = best.clone();
+        lesioned.set_lesioned(k, true);
+        variants.push(lesioned);
+    }
+    variants
 }
 
 #[cfg(test)]

@@ -146,7 +146,7 @@ pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
 
 /// An error naming the first network whose fitness is NaN; `first` is the
 /// index of `fitness[0]`.
-fn check_fitness(fitness: &[f64], first: usize) -> Result<(), RunError> {
+pub(crate) fn check_fitness(fitness: &[f64], first: usize) -> Result<(), RunError> {
     match fitness.iter().position(|f| f.is_nan()) {
         Some(i) => Err(RunError::NanFitness { network: first + i }),
         None => Ok(()),
@@ -158,7 +158,7 @@ fn check_fitness(fitness: &[f64], first: usize) -> Result<(), RunError> {
 /// cut into one piece per thread, but never into pieces of fewer than
 /// `narrowest` networks (see [`Evaluator::narrowest_batch`]), so that a
 /// tail that narrow stays whole.
-fn batch_ranges(networks: usize, size: usize, narrowest: usize, threads: usize) -> Vec<Range<usize>> {
+pub(crate) fn batch_ranges(networks: usize, size: usize, narrowest: usize, threads: usize) -> Vec<Range<usize>> {
     let size = size.max(1);
     let narrowest = narrowest.clamp(1, size);
     let full = networks / size * size;

@@ -3,9 +3,10 @@
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
+use super::ask::{check_told, drive, AskPurpose, AskTell, Asked, Networks};
 use super::operators::{cauchy, random_genes};
 use super::{
-    best_of, check_cauchy_limit, check_count, check_positive, check_probability, evaluate_all, min_and_mean, purpose,
+    best_of, check_cauchy_limit, check_count, check_positive, check_probability, min_and_mean, purpose,
     MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION,
 };
 use super::{
@@ -154,97 +155,243 @@ impl HillClimb {
         }
     }
 
-    /// Runs the cycles on the current rayon pool, calling `on_cycle` after
-    /// each, until the last, or until the stop conditions
-    /// ([`HillClimb::stop_at`]) or `on_cycle` (returning [`Control::Stop`])
-    /// end the run.
-    pub fn run<E: Evaluator, C: Into<Control>>(
-        &self,
-        evaluator: &E,
-        mut on_cycle: impl FnMut(&GenerationRecord) -> C,
-    ) -> Result<RunResult, RunError> {
+    /// Starts the run on networks of `inputs` inputs (the bias included)
+    /// and `outputs` outputs, to be driven by ask and tell ([`AskTell`](crate::AskTell)).
+    /// Fails on a size of 0.
+    pub fn start(&self, inputs: usize, outputs: usize) -> Result<HillClimbRun, RunError> {
         let s = &self.settings;
-        let (inputs, outputs) = (evaluator.inputs(), evaluator.outputs());
         let mut rng = stream(self.seed, &[purpose::INIT]);
-        let mut base = Network::from_genes(
+        let base = Network::from_genes(
             inputs,
             outputs,
             random_genes(&mut rng, s.hidden * (inputs + outputs), s.init_range),
         )?;
-        let mut evaluations = 0u64;
         // The base's fitness matters only to elitist acceptance.
-        let mut base_fitness = if s.elitist {
-            evaluations += 1;
-            evaluate_all(
-                evaluator,
-                std::slice::from_ref(&base),
-                self.seed,
-                &[purpose::EVALUATE, 0],
-            )?[0]
-        } else {
-            f64::NEG_INFINITY
-        };
-        let mut champion: Option<Champion> = None;
-        let mut records = Vec::with_capacity(s.cycles.min(RECORDS_RESERVED));
-        let mut ending = Ending::Completed;
-        for cycle in 1..=s.cycles {
-            let rates = self.rates(cycle);
-            let candidates = (0..s.candidates)
-                .map(|j| {
-                    let mut genes = base.genes().to_vec();
-                    self.mutate(
-                        &mut genes,
-                        rates,
-                        &mut stream(self.seed, &[purpose::MUTATE, cycle as u64, j as u64]),
-                    );
-                    Network::from_genes(inputs, outputs, genes)
-                })
-                .collect::<Result<Vec<_>, _>>()?;
-            let fitness = evaluate_all(
-                evaluator,
-                &candidates[..],
-                self.seed,
-                &[purpose::EVALUATE, cycle as u64],
-            )?;
-            let (top, top_fitness) = best_of(&fitness);
-            if champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
-                champion = Some(Champion {
-                    network: candidates[top].clone(),
-                    fitness: top_fitness,
-                    generation: cycle,
-                    evaluation: evaluations + top as u64 + 1,
-                });
-            }
-            evaluations += candidates.len() as u64;
-            if !s.elitist || top_fitness >= base_fitness {
-                base = candidates[top].clone();
-                base_fitness = top_fitness;
-            }
-            let (min, mean) = min_and_mean(&fitness);
-            let record = GenerationRecord {
-                generation: cycle,
-                min,
-                mean,
-                max: top_fitness,
-                best: Some(base_fitness),
-                champion: champion.as_ref().map_or(f64::NAN, |c| c.fitness),
-                evaluations,
-                subpops: s.hidden,
-                burst: false,
-                bursts: 0,
-                lesion: None,
-            };
-            let decision = self.stop.decide(&record, on_cycle(&record).into());
-            records.push(record);
-            if let Some(end) = decision {
-                ending = end;
-                break;
+        let phase = if s.elitist { Phase::Base } else { Phase::Next };
+        Ok(HillClimbRun {
+            hill_climb: self.clone(),
+            base,
+            base_fitness: f64::NEG_INFINITY,
+            evaluations: 0,
+            champion: None,
+            records: Vec::with_capacity(s.cycles.min(RECORDS_RESERVED)),
+            cycle: 1,
+            phase,
+            stop_requested: false,
+        })
+    }
+
+    /// Runs the cycles on the current rayon pool, calling `on_cycle` after
+    /// each, until the last, or until the stop conditions
+    /// ([`HillClimb::stop_at`]) or `on_cycle` (returning [`Control::Stop`])
+    /// end the run. A loop over [`HillClimb::start`]'s ask, evaluate and
+    /// tell.
+    pub fn run<E: Evaluator, C: Into<Control>>(
+        &self,
+        evaluator: &E,
+        on_cycle: impl FnMut(&GenerationRecord) -> C,
+    ) -> Result<RunResult, RunError> {
+        let mut run = self.start(evaluator.inputs(), evaluator.outputs())?;
+        drive(&mut run, evaluator, on_cycle)?;
+        run.into_result()
+    }
+
+    /// Cycle `cycle`'s candidates: the base mutated with the cycle's
+    /// rates, candidate `j` with its own stream.
+    fn candidates(&self, base: &Network, cycle: usize) -> Result<Vec<Network>, RunError> {
+        let rates = self.rates(cycle);
+        let (inputs, outputs) = (base.inputs(), base.outputs());
+        (0..self.settings.candidates)
+            .map(|j| {
+                let mut genes = base.genes().to_vec();
+                self.mutate(
+                    &mut genes,
+                    rates,
+                    &mut stream(self.seed, &[purpose::MUTATE, cycle as u64, j as u64]),
+                );
+                Ok(Network::from_genes(inputs, outputs, genes)?)
+            })
+            .collect()
+    }
+}
+
+/// A run of [`HillClimb`] under way: [`AskTell::ask`] gives the networks
+/// to evaluate next (elitist: the base first; then each cycle's
+/// candidates), [`AskTell::tell`] their fitness. Made by
+/// [`HillClimb::start`]; the same run, bit for bit, as [`HillClimb::run`].
+pub struct HillClimbRun {
+    hill_climb: HillClimb,
+    base: Network,
+    base_fitness: f64,
+    evaluations: u64,
+    champion: Option<Champion>,
+    records: Vec<GenerationRecord>,
+    /// The cycle under way, or the last one recorded.
+    cycle: usize,
+    phase: Phase,
+    /// [`AskTell::stop`] was called.
+    stop_requested: bool,
+}
+
+/// Where a hill-climbing run stands.
+enum Phase {
+    /// The base is asked (elitist acceptance, before cycle 1).
+    Base,
+    /// Cycle `cycle` is next: its candidates are not made yet.
+    Next,
+    /// Cycle `cycle`'s candidates are asked.
+    Asking(Vec<Network>),
+    /// Cycle `cycle` is recorded; the goal or the budget ended the run
+    /// there if this says so.
+    Recorded(Option<Ending>),
+    /// The run has ended.
+    Ended(Ending),
+}
+
+impl HillClimbRun {
+    /// The run's settings and stop conditions.
+    pub fn hill_climb(&self) -> &HillClimb {
+        &self.hill_climb
+    }
+
+    /// The result of the ended run; [`RunError::NotEnded`] before.
+    pub fn into_result(self) -> Result<RunResult, RunError> {
+        let ending = self.ending().ok_or(RunError::NotEnded)?;
+        Ok(RunResult {
+            champion: self.champion.expect("every cycle has a champion"),
+            records: self.records,
+            ending,
+        })
+    }
+
+    /// How the run ends after cycle `cycle`, recorded with the goal's or
+    /// budget's `decision`.
+    fn decide(&self, decision: Option<Ending>) -> Option<Ending> {
+        decision
+            .or(self.stop_requested.then_some(Ending::Stopped))
+            .or((self.cycle == self.hill_climb.settings.cycles).then_some(Ending::Completed))
+    }
+
+    /// Moves on to the next networks to ask for, or to the end.
+    fn prepare(&mut self) -> Result<(), RunError> {
+        loop {
+            match self.phase {
+                Phase::Recorded(decision) => {
+                    self.phase = match self.decide(decision) {
+                        Some(ending) => Phase::Ended(ending),
+                        None => {
+                            self.cycle += 1;
+                            Phase::Next
+                        }
+                    }
+                }
+                Phase::Next => self.phase = Phase::Asking(self.hill_climb.candidates(&self.base, self.cycle)?),
+                Phase::Base | Phase::Asking(_) | Phase::Ended(_) => return Ok(()),
             }
         }
-        let champion = champion.expect("every cycle has a champion");
+    }
+
+    /// The cycle after its candidates scored `fitness`: champion, base, record.
+    fn conclude(&mut self, candidates: Vec<Network>, fitness: &[f64]) -> GenerationRecord {
+        let s = &self.hill_climb.settings;
+        let cycle = self.cycle;
+        let (top, top_fitness) = best_of(fitness);
+        if self.champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
+            self.champion = Some(Champion {
+                network: candidates[top].clone(),
+                fitness: top_fitness,
+                generation: cycle,
+                evaluation: self.evaluations + top as u64 + 1,
+            });
+        }
+        self.evaluations += candidates.len() as u64;
+        if !s.elitist || top_fitness >= self.base_fitness {
+            self.base = candidates.into_iter().nth(top).expect("the best is a candidate");
+            self.base_fitness = top_fitness;
+        }
+        let (min, mean) = min_and_mean(fitness);
+        GenerationRecord {
+            generation: cycle,
+            min,
+            mean,
+            max: top_fitness,
+            best: Some(self.base_fitness),
+            champion: self.champion.as_ref().map_or(f64::NAN, |c| c.fitness),
+            evaluations: self.evaluations,
+            subpops: s.hidden,
+            burst: false,
+            bursts: 0,
+            lesion: None,
+        }
+    }
+}
+
+impl AskTell for HillClimbRun {
+    fn ask(&mut self) -> Result<Option<Asked<'_>>, RunError> {
+        self.prepare()?;
+        let seed = self.hill_climb.seed;
+        Ok(match &self.phase {
+            Phase::Base => Some(Asked::new(
+                Networks::List(std::slice::from_ref(&self.base)),
+                AskPurpose::Base,
+                seed,
+                [purpose::EVALUATE, 0],
+            )),
+            Phase::Asking(candidates) => Some(Asked::new(
+                Networks::List(candidates),
+                AskPurpose::Generation(self.cycle),
+                seed,
+                [purpose::EVALUATE, self.cycle as u64],
+            )),
+            _ => None,
+        })
+    }
+
+    fn tell(&mut self, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError> {
+        self.prepare()?;
+        let expected = match &self.phase {
+            Phase::Base => 1,
+            Phase::Asking(candidates) => candidates.len(),
+            _ => return Err(RunError::Ended),
+        };
+        check_told(fitness, expected)?;
+        match std::mem::replace(&mut self.phase, Phase::Next) {
+            Phase::Base => {
+                self.evaluations += 1;
+                self.base_fitness = fitness[0];
+                Ok(None)
+            }
+            Phase::Asking(candidates) => {
+                let record = self.conclude(candidates, fitness);
+                self.phase = Phase::Recorded(self.hill_climb.stop.decide(&record, Control::Continue));
+                self.records.push(record);
+                Ok(self.records.last())
+            }
+            _ => unreachable!("checked above"),
+        }
+    }
+
+    fn stop(&mut self) {
+        self.stop_requested = true;
+    }
+
+    fn ending(&self) -> Option<Ending> {
+        match self.phase {
+            Phase::Ended(ending) => Some(ending),
+            Phase::Recorded(decision) => self.decide(decision),
+            Phase::Base | Phase::Next | Phase::Asking(_) => None,
+        }
+    }
+
+    fn records(&self) -> &[GenerationRecord] {
+        &self.records
+    }
+
+    fn result(&self) -> Result<RunResult, RunError> {
+        let ending = self.ending().ok_or(RunError::NotEnded)?;
         Ok(RunResult {
-            champion,
-            records,
+            champion: self.champion.clone().expect("every cycle has a champion"),
+            records: self.records.clone(),
             ending,
         })
     }

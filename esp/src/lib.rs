@@ -28,11 +28,20 @@
 //! let result = Esp::new(settings, 7).unwrap().run(&evaluator, |_| {}).unwrap();
 //! assert!(result.champion.fitness > -0.05);
 //! ```
+//!
+//! A run can also be driven from outside, by ask and tell ([`AskTell`]):
+//! [`Esp::start`] and [`HillClimb::start`] make runs that ask for networks
+//! and are told their fitness; [`lockstep`] advances many such runs
+//! together, evaluating every round's networks of all of them in one batch.
+//! Either way a run is the one [`Esp::run`] gives, bit for bit.
 
+mod ask;
 mod error;
 mod esp;
+mod esp_run;
 mod evaluator;
 mod hill_climb;
+pub mod lockstep;
 pub mod math;
 pub mod network;
 pub mod operators;
@@ -40,10 +49,12 @@ mod record;
 pub mod rng;
 mod subpop;
 
+pub use ask::{AskPurpose, AskTell, Asked};
 pub use error::{RunError, SettingsError};
 pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, StagnationRule, TopologyMode};
+pub use esp_run::EspRun;
 pub use evaluator::{evaluate_all, evaluate_each, Evaluator, FnEvaluator};
-pub use hill_climb::{HillClimb, HillClimbSettings, MutationRates};
+pub use hill_climb::{HillClimb, HillClimbRun, HillClimbSettings, MutationRates};
 pub use record::{Champion, Control, Ending, GenerationRecord, LesionOutcome, RunResult, StopAt};
 
 /// Records reserved at a run's start: at most its generations, which may

@@ -50,7 +50,7 @@ pub(crate) fn first_non_finite(genes: &[f64]) -> Option<usize> {
     genes.iter().position(|v| !v.is_finite())
 }
 
-fn check_sizes(inputs: usize, outputs: usize) -> Result<(), NetworkError> {
+pub(crate) fn check_sizes(inputs: usize, outputs: usize) -> Result<(), NetworkError> {
     if inputs == 0 || outputs == 0 {
         return Err(NetworkError::Shape(format!(
             "inputs and outputs must be >= 1, got {inputs} and {outputs}"

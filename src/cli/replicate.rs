@@ -11,6 +11,7 @@ use super::evolve::progress_bar;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
 use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress, HeldRun, ReplicateOptions};
+use crate::experiment::lockstep::Executor;
 use crate::experiment::shard::Shard;
 use crate::experiment::GridConfig;
 use crate::ode::MAX_THREADS;
@@ -76,6 +77,11 @@ pub struct GridArgs {
     /// Print nothing while the grid runs (no bars, no lines per run).
     #[arg(long)]
     pub quiet: bool,
+    /// Advance all runs together, a generation per round, each round's
+    /// networks of every run evaluated as one batch (for evaluators that
+    /// gain from large batches). Results do not depend on it.
+    #[arg(long)]
+    pub lockstep: bool,
 }
 
 /// A duration such as `48h`, `90m` or `1h 30m`, above zero.
@@ -88,6 +94,15 @@ fn parse_duration(text: &str) -> Result<Duration, String> {
 }
 
 impl GridArgs {
+    /// The executor these options ask for.
+    pub fn executor(&self) -> Executor {
+        if self.lockstep {
+            Executor::Lockstep
+        } else {
+            Executor::RunByRun
+        }
+    }
+
     /// The grid these options describe.
     pub fn spec(&self) -> Result<GridSpec> {
         let mut spec = GridSpec::from_preset(self.preset);
@@ -113,6 +128,11 @@ impl GridArgs {
             threads: self.threads as usize,
             shard: self.shard,
             claim_timeout: self.claim_timeout,
+            executor: if self.lockstep {
+                Executor::Lockstep
+            } else {
+                Executor::RunByRun
+            },
         }
     }
 }

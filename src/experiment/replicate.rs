@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use super::claim::{claim, Attempt, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
 use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
+use super::lockstep::{replicate_lockstep, Executor};
 use super::robustness::test_robustness;
 use super::shard::Shard;
 use super::{run_evolution, EvolveOutcome};
@@ -64,6 +65,9 @@ pub struct ReplicateOptions {
     /// How old another process's claim on a run may grow before this one
     /// takes it over.
     pub claim_timeout: Duration,
+    /// How the runs are advanced: run by run, or all in lockstep. Results
+    /// do not depend on it.
+    pub executor: Executor,
 }
 
 impl Default for ReplicateOptions {
@@ -72,6 +76,7 @@ impl Default for ReplicateOptions {
             threads: 0,
             shard: Shard::ALL,
             claim_timeout: DEFAULT_CLAIM_TIMEOUT,
+            executor: Executor::RunByRun,
         }
     }
 }
@@ -173,8 +178,22 @@ pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun>
     let seed = run_seed(key);
     let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, |_| {})
         .with_context(|| format!("run {}", folder.display()))?;
+    test_and_mark(dir, spec, key, outcome)
+}
+
+/// A run's robustness tests, once its evolution is written; writes
+/// `robustness.json`, which marks it finished.
+pub(super) fn test_and_mark(dir: &Path, spec: &GridSpec, key: &RunKey, outcome: EvolveOutcome) -> Result<FinishedRun> {
+    let folder = run_dir(dir, key);
+    let config = spec.run_config(key.config)?;
     let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
-    let robustness = test_robustness(&champion, key.task, &config.problem, spec.robustness_trials, seed)?;
+    let robustness = test_robustness(
+        &champion,
+        key.task,
+        &config.problem,
+        spec.robustness_trials,
+        outcome.seed,
+    )?;
     let mut json = serde_json::to_string_pretty(&robustness)?;
     json.push('\n');
     crate::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())?;
@@ -225,20 +244,49 @@ pub fn replicate(
     let ran = AtomicU64::new(0);
     let finished_elsewhere = AtomicU64::new(0);
     let lock = "no panics while holding the lock";
-    pool.install(|| {
-        todo.par_iter()
+    let finished = |result: Result<FinishedRun>| match result {
+        Ok(run) => {
+            ran.fetch_add(1, Ordering::Relaxed);
+            progress.finished(&run);
+        }
+        Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
+    };
+    pool.install(|| match options.executor {
+        Executor::RunByRun => todo
+            .par_iter()
             .with_max_len(1)
             .for_each(|key| match claim_and_run(dir, spec, key, options.claim_timeout) {
-                Ok(Outcome::Ran(run)) => {
-                    ran.fetch_add(1, Ordering::Relaxed);
-                    progress.finished(&run);
-                }
+                Ok(Outcome::Ran(run)) => finished(Ok(run)),
                 Ok(Outcome::AlreadyFinished) => {
                     finished_elsewhere.fetch_add(1, Ordering::Relaxed);
                 }
                 Ok(Outcome::Held(claim)) => held.lock().expect(lock).push(HeldRun { key: *key, claim }),
-                Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
-            })
+                Err(e) => finished(Err(e)),
+            }),
+        Executor::Lockstep => {
+            // Every run is claimed before the first round and released once
+            // all are written.
+            let mut claims = Vec::new();
+            let mut mine = Vec::new();
+            for key in &todo {
+                match claim(&run_dir(dir, key), options.claim_timeout) {
+                    Ok(Attempt::Held(record)) => held.lock().expect(lock).push(HeldRun { key: *key, claim: record }),
+                    Ok(Attempt::Claimed(claim)) => match run_status(dir, spec, key) {
+                        Ok(RunStatus::Finished) => {
+                            finished_elsewhere.fetch_add(1, Ordering::Relaxed);
+                        }
+                        Ok(_) => {
+                            claims.push(claim);
+                            mine.push(*key);
+                        }
+                        Err(e) => finished(Err(e)),
+                    },
+                    Err(e) => finished(Err(e)),
+                }
+            }
+            replicate_lockstep(dir, spec, &mine, &finished);
+            drop(claims);
+        }
     });
     let failures = failures.into_inner().expect(lock);
     if !failures.is_empty() {

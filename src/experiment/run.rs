@@ -139,16 +139,10 @@ pub fn run_evolution(
     dir: &Path,
     mut on_generation: impl FnMut(&GenerationRecord),
 ) -> Result<EvolveOutcome> {
-    config.validate()?;
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
-    let files = RunFiles::in_dir(dir);
-    write_atomic(&files.config, config.to_toml()?.as_bytes())?;
-    let started = crate::provenance::now_rfc3339();
-    let clock = Instant::now();
+    let mut started = RunStart::new(config, dir)?;
     let evaluator = PsaEvaluator::new(config.problem.clone(), task)?;
-    let mut live = LiveRecords::create(&files.records);
     let on_generation = |record: &GenerationRecord| {
-        live.push(record);
+        started.record(record);
         on_generation(record);
     };
     let result: RunResult = match config.algorithm {
@@ -159,35 +153,80 @@ pub fn run_evolution(
             .map_err(anyhow::Error::msg)?
             .run(&evaluator, on_generation)?,
     };
-    let seconds = clock.elapsed().as_secs_f64();
-    write_atomic(&files.records, records_csv(&result.records).as_bytes())?;
-    let champion = &result.champion;
-    let mut extra = serde_json::Map::new();
-    extra.insert("configuration".into(), label.into());
-    extra.insert("seed".into(), seed.to_string().into());
-    extra.insert("fitness_percent".into(), champion.fitness.into());
-    extra.insert("generation".into(), champion.generation.into());
-    extra.insert("backend".into(), config.problem.backend.name().into());
-    NetworkFile::new(&champion.network, task, &config.problem, extra).save(&files.champion)?;
-    let last = result.records.last().context("a run has at least one generation")?;
-    let outcome = EvolveOutcome {
-        task,
-        seed,
-        label: label.to_string(),
-        backend: config.problem.backend,
-        champion_fitness: champion.fitness,
-        champion_generation: champion.generation,
-        generations: result.records.len(),
-        evaluations: last.evaluations,
-        bursts: last.bursts,
-        champion_hidden: champion.network.hidden(),
-        build: crate::provenance::build_info(),
-        started,
-        finished: crate::provenance::now_rfc3339(),
-        seconds,
-    };
-    let mut json = serde_json::to_string_pretty(&outcome)?;
-    json.push('\n');
-    write_atomic(&files.summary, json.as_bytes())?;
-    Ok(outcome)
+    started.finish(config, label, task, seed, &result)
+}
+
+/// A run begun on disk: its folder made, `config.toml` written and
+/// `records.csv` growing a line per generation; its start time and clock.
+pub struct RunStart {
+    files: RunFiles,
+    live: LiveRecords,
+    started: String,
+    clock: Instant,
+}
+
+impl RunStart {
+    /// Checks `config`, makes `dir` and writes `config.toml` into it.
+    pub fn new(config: &RunConfig, dir: &Path) -> Result<RunStart> {
+        config.validate()?;
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        let files = RunFiles::in_dir(dir);
+        write_atomic(&files.config, config.to_toml()?.as_bytes())?;
+        let live = LiveRecords::create(&files.records);
+        Ok(RunStart {
+            files,
+            live,
+            started: crate::provenance::now_rfc3339(),
+            clock: Instant::now(),
+        })
+    }
+
+    /// Appends one generation's line to the live `records.csv`.
+    pub fn record(&mut self, record: &GenerationRecord) {
+        self.live.push(record);
+    }
+
+    /// Writes the run's `result` (`records.csv` whole and atomically,
+    /// `champion.json`, `run.json`).
+    pub fn finish(
+        self,
+        config: &RunConfig,
+        label: &str,
+        task: Task,
+        seed: u64,
+        result: &RunResult,
+    ) -> Result<EvolveOutcome> {
+        let files = self.files;
+        let seconds = self.clock.elapsed().as_secs_f64();
+        write_atomic(&files.records, records_csv(&result.records).as_bytes())?;
+        let champion = &result.champion;
+        let mut extra = serde_json::Map::new();
+        extra.insert("configuration".into(), label.into());
+        extra.insert("seed".into(), seed.to_string().into());
+        extra.insert("fitness_percent".into(), champion.fitness.into());
+        extra.insert("generation".into(), champion.generation.into());
+        extra.insert("backend".into(), config.problem.backend.name().into());
+        NetworkFile::new(&champion.network, task, &config.problem, extra).save(&files.champion)?;
+        let last = result.records.last().context("a run has at least one generation")?;
+        let outcome = EvolveOutcome {
+            task,
+            seed,
+            label: label.to_string(),
+            backend: config.problem.backend,
+            champion_fitness: champion.fitness,
+            champion_generation: champion.generation,
+            generations: result.records.len(),
+            evaluations: last.evaluations,
+            bursts: last.bursts,
+            champion_hidden: champion.network.hidden(),
+            build: crate::provenance::build_info(),
+            started: self.started,
+            finished: crate::provenance::now_rfc3339(),
+            seconds,
+        };
+        let mut json = serde_json::to_string_pretty(&outcome)?;
+        json.push('\n');
+        write_atomic(&files.summary, json.as_bytes())?;
+        Ok(outcome)
+    }
 }

@@ -1,0 +1,244 @@
+//! Runs as state machines: ask for the networks to evaluate next, tell
+//! their fitness, repeat (the interface of evosax or EvoTorch).
+//!
+//! [`Esp::start`](crate::Esp::start) and
+//! [`HillClimb::start`](crate::HillClimb::start) make a run that
+//! [`AskTell::ask`] asks for a batch of networks (a generation's, a lesion
+//! test's, the hill-climber's base) with the random streams each must be
+//! evaluated with, and that [`AskTell::tell`] advances by their fitness.
+//! Whoever evaluates them (one thread, a cluster, a GPU, or one batch for
+//! many runs, as [`lockstep`](crate::lockstep) does) gets the same run, bit
+//! for bit, as [`Esp::run`](crate::Esp::run), which is itself a loop over
+//! ask, evaluate and tell.
+
+use std::borrow::Cow;
+
+use crate::esp::Assembled;
+use crate::evaluator::evaluate_all;
+use crate::network::{Network, NetworkSet};
+use crate::rng::StreamFamily;
+use crate::{Control, Ending, Evaluator, GenerationRecord, RunError, RunResult};
+
+/// What a batch of asked networks is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AskPurpose {
+    /// The networks of ESP's generation (or the hill-climber's cycle) `n`.
+    Generation(usize),
+    /// ESP's lesion test at the end of generation `n`: the search's best
+    /// network whole, then with each hidden neuron lesioned in turn.
+    LesionTest(usize),
+    /// The hill-climber's initial base network, evaluated for elitist
+    /// acceptance before the first cycle.
+    Base,
+}
+
+/// The networks a run asks to have evaluated, and the streams to evaluate
+/// them with: network `j` of the batch must be scored with
+/// `streams().stream(j)` (that is, `rng::stream(seed(), [key().., j])`),
+/// which [`Asked::evaluate`] does. It reads the networks in place from
+/// the run (ESP's sub-populations and picks, say) as a [`NetworkSet`].
+pub struct Asked<'a> {
+    networks: Networks<'a>,
+    purpose: AskPurpose,
+    seed: u64,
+    key: [u64; 2],
+}
+
+/// Where an ask's networks live.
+pub(crate) enum Networks<'a> {
+    /// Whole networks.
+    List(&'a [Network]),
+    /// ESP's generation, read from its sub-populations.
+    Set(Assembled<'a>),
+}
+
+impl<'a> Asked<'a> {
+    /// The networks of `purpose`, with the streams of `seed` and `key`.
+    pub(crate) fn new(networks: Networks<'a>, purpose: AskPurpose, seed: u64, key: [u64; 2]) -> Asked<'a> {
+        Asked {
+            networks,
+            purpose,
+            seed,
+            key,
+        }
+    }
+
+    /// What the networks are for.
+    pub fn purpose(&self) -> AskPurpose {
+        self.purpose
+    }
+
+    /// The run's seed: network `j` is evaluated with
+    /// `rng::stream(seed(), [key().., j])`.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The key prefix of the networks' streams (purpose and generation).
+    pub fn key(&self) -> &[u64] {
+        &self.key
+    }
+
+    /// The networks' streams: network `j` takes `streams().stream(j)`.
+    pub fn streams(&self) -> StreamFamily {
+        StreamFamily::new(self.seed, &self.key)
+    }
+
+    /// Evaluates the networks with `evaluator` on the current rayon pool,
+    /// each with its stream ([`evaluate_all`]): the fitness to tell.
+    pub fn evaluate<E: Evaluator>(&self, evaluator: &E) -> Result<Vec<f64>, RunError> {
+        evaluate_all(evaluator, self, self.seed, &self.key)
+    }
+}
+
+impl NetworkSet for Asked<'_> {
+    fn len(&self) -> usize {
+        match self.networks {
+            Networks::List(list) => list.len(),
+            Networks::Set(ref set) => set.len(),
+        }
+    }
+    fn shape(&self, j: usize) -> (usize, usize) {
+        match self.networks {
+            Networks::List(list) => NetworkSet::shape(list, j),
+            Networks::Set(ref set) => set.shape(j),
+        }
+    }
+    fn hidden(&self, j: usize) -> usize {
+        match self.networks {
+            Networks::List(list) => list[j].hidden(),
+            Networks::Set(ref set) => set.hidden(j),
+        }
+    }
+    fn neuron(&self, j: usize, k: usize) -> &[f64] {
+        match self.networks {
+            Networks::List(list) => list[j].neuron(k),
+            Networks::Set(ref set) => set.neuron(j, k),
+        }
+    }
+    fn is_lesioned(&self, j: usize, k: usize) -> bool {
+        match self.networks {
+            Networks::List(list) => list[j].is_lesioned(k),
+            Networks::Set(ref set) => set.is_lesioned(j, k),
+        }
+    }
+    fn network(&self, j: usize) -> Cow<'_, Network> {
+        match self.networks {
+            Networks::List(list) => Cow::Borrowed(&list[j]),
+            Networks::Set(ref set) => set.network(j),
+        }
+    }
+}
+
+/// A run driven from outside: [`AskTell::ask`] for networks,
+/// [`AskTell::tell`] their fitness, until `ask` answers `None`. ESP's
+/// [`EspRun`](crate::EspRun) and the hill-climber's
+/// [`HillClimbRun`](crate::HillClimbRun) are ones.
+///
+/// ```
+/// use esp_neuroevolution::network::Network;
+/// use esp_neuroevolution::{AskTell, Esp, EspSettings, FnEvaluator};
+///
+/// let evaluator = FnEvaluator::new(2, 1, |net: &Network, _: &mut esp_neuroevolution::rng::Stream| {
+///     let mut out = [0.0];
+///     net.activate(&[0.5, 1.0], &mut out);
+///     Ok(-(out[0] - 0.25).abs())
+/// });
+/// let esp = Esp::new(EspSettings { subpop_size: 8, generations: 20, ..EspSettings::default() }, 3)?;
+/// let mut run = esp.start(2, 1)?;
+/// while let Some(asked) = run.ask()? {
+///     // Evaluate anywhere, any way, as long as network j uses asked.streams().stream(j).
+///     let fitness = asked.evaluate(&evaluator)?;
+///     if let Some(record) = run.tell(&fitness)? {
+///         println!("generation {}: best {}", record.generation, record.max);
+///     }
+/// }
+/// let result = run.into_result()?;
+/// // The same run, bit for bit, as Esp::run.
+/// assert_eq!(result.records, esp.run(&evaluator, |_| {})?.records);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub trait AskTell {
+    /// The networks to evaluate next, or `None` once the run has ended.
+    /// Asking again before telling asks for the same networks. Fails when
+    /// the search's weights overflowed.
+    fn ask(&mut self) -> Result<Option<Asked<'_>>, RunError>;
+
+    /// Advances the run by the fitness of the asked networks, in order.
+    /// Returns the record of the generation (cycle) this completes, if it
+    /// completes one. Fails, leaving the run as it was, on a count of
+    /// fitnesses other than the ask's ([`RunError::FitnessCount`]), on a
+    /// NaN ([`RunError::NanFitness`]) or once the run has ended
+    /// ([`RunError::Ended`]).
+    fn tell(&mut self, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError>;
+
+    /// Ends the run once its current generation (cycle) is complete, as a
+    /// per-generation callback of `run` returning [`Control::Stop`] does;
+    /// the run's [`Ending`] is then [`Ending::Stopped`] unless its goal or
+    /// budget ended it there first.
+    fn stop(&mut self);
+
+    /// Why the run ended, once it has (after the last `tell`, `ask`
+    /// answers `None`).
+    fn ending(&self) -> Option<Ending>;
+
+    /// The records of the generations (cycles) completed so far.
+    fn records(&self) -> &[GenerationRecord];
+
+    /// The result of the ended run (a copy); [`RunError::NotEnded`] before.
+    fn result(&self) -> Result<RunResult, RunError>;
+}
+
+impl<T: AskTell + ?Sized> AskTell for Box<T> {
+    fn ask(&mut self) -> Result<Option<Asked<'_>>, RunError> {
+        (**self).ask()
+    }
+    fn tell(&mut self, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError> {
+        (**self).tell(fitness)
+    }
+    fn stop(&mut self) {
+        (**self).stop()
+    }
+    fn ending(&self) -> Option<Ending> {
+        (**self).ending()
+    }
+    fn records(&self) -> &[GenerationRecord] {
+        (**self).records()
+    }
+    fn result(&self) -> Result<RunResult, RunError> {
+        (**self).result()
+    }
+}
+
+/// Drives `run` to its end on the current rayon pool: ask, evaluate with
+/// `evaluator`, tell, and call `on_generation` with every record (its
+/// [`Control::Stop`] stops the run).
+pub(crate) fn drive<R: AskTell + ?Sized, E: Evaluator, C: Into<Control>>(
+    run: &mut R,
+    evaluator: &E,
+    mut on_generation: impl FnMut(&GenerationRecord) -> C,
+) -> Result<(), RunError> {
+    while let Some(asked) = run.ask()? {
+        let fitness = asked.evaluate(evaluator)?;
+        if let Some(record) = run.tell(&fitness)? {
+            if on_generation(record).into() == Control::Stop {
+                run.stop();
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks told fitness against the ask: its count, then NaN.
+pub(crate) fn check_told(fitness: &[f64], expected: usize) -> Result<(), RunError> {
+    if fitness.len() != expected {
+        return Err(RunError::FitnessCount {
+            expected,
+            got: fitness.len(),
+        });
+    }
+    match fitness.iter().position(|f| f.is_nan()) {
+        Some(network) => Err(RunError::NanFitness { network }),
+        None => Ok(()),
+    }
+}
