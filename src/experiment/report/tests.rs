@@ -192,8 +192,20 @@ fn writes_markdown_figures_csv_and_json() {
     assert_eq!((outcome.counted, outcome.expected), (18, 18));
     assert_eq!(
         outcome.written,
-        vec![dir.path().join("report.md"), dir.path().join("report.json")]
+        vec![
+            dir.path().join("report.md"),
+            dir.path().join("runs.csv"),
+            dir.path().join("report.json")
+        ]
     );
+    // runs.csv: a row per run; run.json's seed here is the number 1234 (the
+    // form older builds wrote), read as well as a string.
+    let runs = std::fs::read_to_string(dir.path().join("runs.csv")).unwrap();
+    let rows: Vec<&str> = runs.lines().collect();
+    assert_eq!(rows.len(), 1 + 18);
+    assert!(rows[0].starts_with("configuration,task,seed,run_seed,champion_fitness,"));
+    assert!(rows[1].starts_with("baseline,1,1,1234,"), "{}", rows[1]);
+    assert!(rows[1].contains(",native,0.1.0,abc123,1.5"), "{}", rows[1]);
     let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
     assert_eq!(md, outcome.markdown);
     for text in [
@@ -229,7 +241,7 @@ fn writes_markdown_figures_csv_and_json() {
     assert_eq!(json["findings"][0]["verdict"], "reproduced");
 
     let outcome = write_report(dir.path(), ReportFormat::Csv).unwrap();
-    assert_eq!(outcome.written[1], dir.path().join("report.csv"));
+    assert_eq!(outcome.written[2], dir.path().join("report.csv"));
     let csv = std::fs::read_to_string(dir.path().join("report.csv")).unwrap();
     assert!(csv.starts_with("table,configuration,metric,task,n,mean,sd,p,paper_mean,paper_sd,paper_p\n"));
     assert!(csv.contains("\n1,baseline,champion,1,3,20,10,,42.4,12.8,\n"), "{csv}");
