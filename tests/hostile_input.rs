@@ -371,7 +371,11 @@ fn cases(f: &mut Fixtures) -> Vec<Case> {
         strings(&["evolve", "--task", "1", "--threads", "1000000", "--out", &f.path("t")]),
         "--threads",
     );
-    add(3, strings(&["replicate", "--jobs", "1000000", "--out", &out]), "--jobs");
+    add(
+        3,
+        strings(&["replicate", "--threads", "1000000", "--out", &out]),
+        "--threads",
+    );
     add(
         3,
         strings(&["evolve", "--task", "1", "--config", &fifo, "--out", &f.path("fifo-out")]),

@@ -163,7 +163,7 @@ fn a_grid_in_lockstep_writes_the_files_of_run_by_run_byte_for_byte() {
         .chain([out.to_str().unwrap().to_string()])
         .collect();
         if lockstep {
-            args.extend(["--lockstep".into(), "--jobs".into(), "2".into()]);
+            args.extend(["--lockstep".into(), "--threads".into(), "2".into()]);
         } else {
             args.extend(["--jobs".into(), "1".into()]);
         }

@@ -4,7 +4,7 @@
 //! files as one process, each run done by exactly one shard.
 //!
 //! Needs root and the Debian packages munge, slurmctld, slurmd and
-//! slurm-client (`.ci/install-deps` installs them). Without them the test
+//! slurm-client (`.ci/install-deps --tests` installs them). Without them the test
 //! fails, unless PSA_ESP_SKIP_SLURM=1 says to skip it.
 
 mod common;
@@ -75,7 +75,7 @@ fn a_slurm_job_array_gives_the_single_process_grid() {
         }
         panic!(
             "SLURM is not installed: install the Debian packages munge slurmctld slurmd slurm-client \
-             (.ci/install-deps does), or set PSA_ESP_SKIP_SLURM=1 to skip this test"
+             (.ci/install-deps --tests does), or set PSA_ESP_SKIP_SLURM=1 to skip this test"
         );
     }
     let tmp = tempfile::tempdir().unwrap();

@@ -10,8 +10,8 @@ use anyhow::Result;
 use super::evolve::progress_bar;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
-use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress, HeldRun, ReplicateOptions};
 use crate::experiment::lockstep::Executor;
+use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress, HeldRun, ReplicateOptions};
 use crate::experiment::shard::Shard;
 use crate::experiment::GridConfig;
 use crate::ode::MAX_THREADS;
@@ -128,11 +128,7 @@ impl GridArgs {
             threads: self.threads as usize,
             shard: self.shard,
             claim_timeout: self.claim_timeout,
-            executor: if self.lockstep {
-                Executor::Lockstep
-            } else {
-                Executor::RunByRun
-            },
+            executor: self.executor(),
         }
     }
 }

@@ -68,7 +68,10 @@ pub(super) fn replicate_lockstep(
     let which: Vec<&PsaEvaluator> = started.iter().map(|s| &evaluators[s.evaluator].1).collect();
     let live: Vec<Mutex<&mut RunStart>> = started.iter_mut().map(|s| Mutex::new(&mut s.start)).collect();
     let errors = lockstep(&mut runs, &which, |run, record| {
-        live[run].lock().expect("no panics while holding the lock").record(record);
+        live[run]
+            .lock()
+            .expect("no panics while holding the lock")
+            .record(record);
         Control::Continue
     });
     drop(live);

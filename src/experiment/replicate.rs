@@ -252,17 +252,18 @@ pub fn replicate(
         Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
     };
     pool.install(|| match options.executor {
-        Executor::RunByRun => todo
-            .par_iter()
-            .with_max_len(1)
-            .for_each(|key| match claim_and_run(dir, spec, key, options.claim_timeout) {
-                Ok(Outcome::Ran(run)) => finished(Ok(run)),
-                Ok(Outcome::AlreadyFinished) => {
-                    finished_elsewhere.fetch_add(1, Ordering::Relaxed);
-                }
-                Ok(Outcome::Held(claim)) => held.lock().expect(lock).push(HeldRun { key: *key, claim }),
-                Err(e) => finished(Err(e)),
-            }),
+        Executor::RunByRun => {
+            todo.par_iter()
+                .with_max_len(1)
+                .for_each(|key| match claim_and_run(dir, spec, key, options.claim_timeout) {
+                    Ok(Outcome::Ran(run)) => finished(Ok(run)),
+                    Ok(Outcome::AlreadyFinished) => {
+                        finished_elsewhere.fetch_add(1, Ordering::Relaxed);
+                    }
+                    Ok(Outcome::Held(claim)) => held.lock().expect(lock).push(HeldRun { key: *key, claim }),
+                    Err(e) => finished(Err(e)),
+                })
+        }
         Executor::Lockstep => {
             // Every run is claimed before the first round and released once
             // all are written.
@@ -270,7 +271,10 @@ pub fn replicate(
             let mut mine = Vec::new();
             for key in &todo {
                 match claim(&run_dir(dir, key), options.claim_timeout) {
-                    Ok(Attempt::Held(record)) => held.lock().expect(lock).push(HeldRun { key: *key, claim: record }),
+                    Ok(Attempt::Held(record)) => held.lock().expect(lock).push(HeldRun {
+                        key: *key,
+                        claim: record,
+                    }),
                     Ok(Attempt::Claimed(claim)) => match run_status(dir, spec, key) {
                         Ok(RunStatus::Finished) => {
                             finished_elsewhere.fetch_add(1, Ordering::Relaxed);
