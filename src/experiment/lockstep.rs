@@ -1,9 +1,9 @@
 //! The lockstep grid executor: every run of a grid (or of what is left of
 //! it) advanced together, one round per generation, each round's networks
-//! of all runs evaluated in one batch (the search crate's
-//! [`lockstep`](crate::evolution::lockstep::lockstep)). Each run is the run
-//! it is on its own, bit for bit: its files are byte-identical to those of
-//! the run-by-run executor (run.json's times aside).
+//! of all runs evaluated in one batch (the search crate's [`lockstep`]).
+//! Each run is the run it is on its own, bit for bit: its files are
+//! byte-identical to those of the run-by-run executor (run.json's times
+//! aside).
 
 use std::path::Path;
 use std::sync::Mutex;
