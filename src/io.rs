@@ -87,14 +87,7 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
 /// a long output never has to be held in memory). When `write` fails,
 /// `path` is left as it was and its error is returned.
 pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .with_context(|| format!("{} is not a file path", path.display()))?;
-    let tmp = dir.join(temporary_name(&name.to_string_lossy()));
+    let (dir, tmp) = temporary_beside(path)?;
     let result = (|| -> Result<()> {
         let mut file = BufWriter::new(fs::File::create(&tmp)?);
         write(&mut file)?;
@@ -110,14 +103,9 @@ pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Resu
     result.with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Creates `path` with `contents` unless it exists: `Ok(true)` when this
-/// call created it, `Ok(false)` when it was already there (its contents
-/// untouched). The file appears whole: it is written under a temporary name
-/// and hard-linked to `path`, which fails when `path` exists; on a file
-/// system without hard links it is created exclusively and then written.
-/// Several processes on several hosts may race for one `path`: exactly one
-/// creates it.
-pub fn create_new_atomic(path: &Path, contents: &[u8]) -> Result<bool> {
+/// The folder of `path` and a fresh temporary file name in it (see
+/// [`temporary_name`]), for writing `path` under another name first.
+fn temporary_beside(path: &Path) -> Result<(&Path, std::path::PathBuf)> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -126,6 +114,18 @@ pub fn create_new_atomic(path: &Path, contents: &[u8]) -> Result<bool> {
         .file_name()
         .with_context(|| format!("{} is not a file path", path.display()))?;
     let tmp = dir.join(temporary_name(&name.to_string_lossy()));
+    Ok((dir, tmp))
+}
+
+/// Creates `path` with `contents` unless it exists: `Ok(true)` when this
+/// call created it, `Ok(false)` when it was already there (its contents
+/// untouched). The file appears whole: it is written under a temporary name
+/// and hard-linked to `path`, which fails when `path` exists; on a file
+/// system without hard links it is created exclusively and then written.
+/// Several processes on several hosts may race for one `path`: exactly one
+/// creates it.
+pub fn create_new_atomic(path: &Path, contents: &[u8]) -> Result<bool> {
+    let (dir, tmp) = temporary_beside(path)?;
     let result = (|| -> std::io::Result<bool> {
         let mut file = fs::File::create(&tmp)?;
         file.write_all(contents)?;
