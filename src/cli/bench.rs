@@ -47,14 +47,17 @@ pub struct BenchArgs {
     pub json: bool,
 }
 
-/// A way of evaluating networks: a backend, and on `native` the scalar
-/// reference or the batched path on one SIMD level.
+/// A way of evaluating networks: a backend, on `native` the scalar
+/// reference or the batched path on one SIMD level, on `ode` one world per
+/// network or the lockstep path (many bodies in one world).
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct EvaluationPath {
     /// The physics backend.
     pub backend: BackendKind,
     /// The batched path's SIMD level; `None` for the scalar path.
     pub simd: Option<SimdLevel>,
+    /// On `ode`, the lockstep path; otherwise one world per network.
+    pub ode_lockstep: bool,
 }
 
 impl EvaluationPath {
@@ -63,23 +66,37 @@ impl EvaluationPath {
         match (self.backend, self.simd) {
             (BackendKind::Native, None) => "native scalar".into(),
             (BackendKind::Native, Some(level)) => format!("native batched {level}"),
+            (BackendKind::Ode, _) if self.ode_lockstep => "ode lockstep".into(),
+            (BackendKind::Ode, _) => "ode one world each".into(),
             (backend, _) => backend.name().into(),
         }
     }
 
-    /// ode, native scalar, native batched on every level the CPU has, rapier.
+    /// ode one world per network and in lockstep, native scalar, native
+    /// batched on every level the CPU has, rapier.
     pub fn all() -> Vec<EvaluationPath> {
         let mut paths = Vec::new();
         for backend in BackendKind::available() {
-            paths.push(EvaluationPath { backend, simd: None });
+            let path = EvaluationPath {
+                backend,
+                simd: None,
+                ode_lockstep: false,
+            };
+            paths.push(path);
+            if backend == BackendKind::Ode {
+                paths.push(EvaluationPath {
+                    ode_lockstep: true,
+                    ..path
+                });
+            }
             if backend == BackendKind::Native {
                 paths.extend(
                     SimdLevel::ALL
                         .into_iter()
                         .filter(|l| l.is_supported())
                         .map(|level| EvaluationPath {
-                            backend,
                             simd: Some(level),
+                            ..path
                         }),
                 );
             }
@@ -93,7 +110,9 @@ impl EvaluationPath {
             backend: self.backend,
             ..PsaSettings::default()
         };
-        Ok(PsaEvaluator::new(settings, Task::StopRotation)?.with_batching(self.simd))
+        Ok(PsaEvaluator::new(settings, Task::StopRotation)?
+            .with_batching(self.simd)
+            .with_ode_lockstep(self.ode_lockstep))
     }
 }
 

@@ -4,6 +4,7 @@
 mod config;
 mod evaluator;
 pub mod grid;
+pub mod ode_check;
 pub mod replicate;
 pub mod report;
 pub mod robustness;
