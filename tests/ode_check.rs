@@ -82,7 +82,10 @@ fn a_grid_with_the_ode_check_records_identical_values_for_every_champion() {
         // champion's own.
         if summary["label"] == "baseline" {
             let fitness = summary["ode_check"]["fitness"]["ode"].as_f64().unwrap();
-            assert_eq!(fitness.to_bits(), summary["champion_fitness"].as_f64().unwrap().to_bits());
+            assert_eq!(
+                fitness.to_bits(),
+                summary["champion_fitness"].as_f64().unwrap().to_bits()
+            );
         }
     }
     // The robustness file holds the native results the check compared.
@@ -98,7 +101,16 @@ fn a_grid_with_the_ode_check_records_identical_values_for_every_champion() {
 #[test]
 fn the_paper_preset_checks_on_ode_by_default_and_the_check_needs_native() {
     let tmp = tempfile::tempdir().unwrap();
-    let tiny = ["--configs", "baseline", "--tasks", "2", "--seeds", "1", "--generations", "2"];
+    let tiny = [
+        "--configs",
+        "baseline",
+        "--tasks",
+        "2",
+        "--seeds",
+        "1",
+        "--generations",
+        "2",
+    ];
     let run = |name: &str, extra: &[&str]| {
         let out = tmp.path().join(name);
         let mut args = vec!["replicate", "--robustness-trials", "3", "--out", out.to_str().unwrap()];
@@ -111,7 +123,10 @@ fn the_paper_preset_checks_on_ode_by_default_and_the_check_needs_native() {
     assert_eq!(json(&out.join("grid.json"))["ode_check"], true);
     assert_identical_check(&summaries(&out)[0], 2);
 
-    let (o, out) = run("unchecked", &["--preset", "paper", "--backend", "native", "--no-ode-check"]);
+    let (o, out) = run(
+        "unchecked",
+        &["--preset", "paper", "--backend", "native", "--no-ode-check"],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(json(&out.join("grid.json"))["ode_check"], false);
     assert!(summaries(&out)[0].get("ode_check").is_none());

@@ -5,8 +5,8 @@
 
 use psa_esp::network::Network;
 use psa_esp::physics::{
-    random_thrust_sequence, BodyState, OdeBackend, OdeFleet, PhysicsBackend, PlanarState, PlaneConstraint, StepSettings,
-    Stepper,
+    random_thrust_sequence, BodyState, OdeBackend, OdeFleet, PhysicsBackend, PlanarState, PlaneConstraint,
+    StepSettings, Stepper,
 };
 use psa_esp::psa::ode_lockstep::ODE_LOCKSTEP;
 use psa_esp::psa::{BodySettings, NoiseSettings, OdeLockstepRunner, PsaSettings, Task, TrialRunner};
@@ -36,7 +36,15 @@ fn bits(values: &[f64]) -> Vec<u64> {
 }
 
 fn state_bits(s: &PlanarState<f64>) -> Vec<u64> {
-    bits(&[s.position[0], s.position[1], s.velocity[0], s.velocity[1], s.quaternion[0], s.quaternion[1], s.omega])
+    bits(&[
+        s.position[0],
+        s.position[1],
+        s.velocity[0],
+        s.velocity[1],
+        s.quaternion[0],
+        s.quaternion[1],
+        s.omega,
+    ])
 }
 
 /// The fitness of networks `seeds` with one ODE world per network, and in
@@ -65,9 +73,18 @@ fn both_paths(settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>, b
 
 fn assert_same(settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>, batch: usize, what: &str) {
     let (scalar, lockstep) = both_paths(settings, task, seeds, batch);
-    assert_eq!(bits(&scalar), bits(&lockstep), "{what}: scalar {scalar:?}\nlockstep {lockstep:?}");
+    assert_eq!(
+        bits(&scalar),
+        bits(&lockstep),
+        "{what}: scalar {scalar:?}\nlockstep {lockstep:?}"
+    );
     let distinct: std::collections::HashSet<u64> = bits(&scalar).into_iter().collect();
-    assert!(distinct.len() >= scalar.len() / 8, "{what}: the sample is degenerate: {} distinct of {}", distinct.len(), scalar.len());
+    assert!(
+        distinct.len() >= scalar.len() / 8,
+        "{what}: the sample is degenerate: {} distinct of {}",
+        distinct.len(),
+        scalar.len()
+    );
 }
 
 #[test]
@@ -248,10 +265,18 @@ fn an_esp_run_on_ode_is_the_same_in_lockstep_and_one_world_per_network_on_any_th
             .with_ode_lockstep(lockstep);
         let pool = psa_esp::ode::thread_pool(threads).unwrap();
         let result = pool.install(|| esp.run(&evaluator, |_| {})).unwrap();
-        (result.records, result.champion.network, result.champion.fitness.to_bits())
+        (
+            result.records,
+            result.champion.network,
+            result.champion.fitness.to_bits(),
+        )
     };
     let reference = run(false, 1);
     for (lockstep, threads) in [(true, 1), (true, 2)] {
-        assert_eq!(run(lockstep, threads), reference, "lockstep {lockstep} on {threads} threads");
+        assert_eq!(
+            run(lockstep, threads),
+            reference,
+            "lockstep {lockstep} on {threads} threads"
+        );
     }
 }

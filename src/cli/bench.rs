@@ -1,8 +1,10 @@
 //! `psa-esp bench`: in one run, ns per physics step of every backend
 //! (interleaved so that machine noise hits them alike), ns per
-//! network-step and evaluations per second of every evaluation path (ode,
-//! native scalar, native batched on each SIMD level, rapier) on 1 and 2
-//! threads, the logistic function alone on the batched path (the bulk of
+//! network-step and evaluations per second of every evaluation path (ode
+//! one world per network and in lockstep, native scalar, native batched on
+//! each SIMD level, rapier) on 1 and 2 threads, the ODE lockstep path by
+//! bodies per world (see [`super::bench_ode`]), the logistic function
+//! alone on the batched path (the bulk of
 //! its arithmetic), and the 2-thread speed-up and algorithm overhead of
 //! `evolve` and `replicate` (see [`super::bench_runs`]).
 
@@ -323,6 +325,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    let lockstep = super::bench_ode::lockstep_by_world_size(&networks, args.rounds)?;
     let best_batched = evaluations
         .iter()
         .filter(|e| e.path.simd.is_some())
@@ -351,6 +354,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             "ode_path": ode_path,
             "networks_per_round": args.networks,
             "psa_evaluation": evaluations,
+            "ode_lockstep_by_world_size": lockstep,
             "simd_level_in_use": SimdLevel::detect(),
             "logistic_function": logistic,
             "evolve": evolve,
@@ -406,6 +410,14 @@ pub fn run(args: BenchArgs) -> Result<i32> {
                 e.ns_per_network_step_1_thread
             );
         }
+        let sizes: Vec<String> = lockstep
+            .iter()
+            .map(|t| format!("{} {:.1}", t.bodies, t.ns_per_network_step))
+            .collect();
+        say!(
+            "ode lockstep, ns/network-step by bodies per world (1 thread, median): {}",
+            sizes.join(", ")
+        );
         say!(
             "logistic function alone (blocks of {LANES} values, best SIMD level): {:.2} ns per value; the {} of a network-step take {:.1} % of the batched network-step",
             logistic.ns_per_value,

@@ -118,7 +118,11 @@ pub fn describe(spec: &GridSpec) -> String {
         spec.seeds,
         spec.generations,
         spec.backend,
-        if spec.ode_check { " (every champion checked on ode)" } else { "" },
+        if spec.ode_check {
+            " (every champion checked on ode)"
+        } else {
+            ""
+        },
         spec.robustness_trials
     )
 }

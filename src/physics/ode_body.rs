@@ -3,7 +3,9 @@
 //! [`super::OdeFleet`]. Sharing these functions is what makes the two
 //! paths do the same ODE calls with the same values for every body.
 
-use super::{BodyState, MassPart, MassProperties, PhysicsError, PlanarState, PlaneConstraint, RigidBodyModel, StepSettings};
+use super::{
+    BodyState, MassPart, MassProperties, PhysicsError, PlanarState, PlaneConstraint, RigidBodyModel, StepSettings,
+};
 use crate::ode::{Body, Joint, Mass, World};
 
 /// A thruster's force at full command and its mount relative to the centre of mass.

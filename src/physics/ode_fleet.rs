@@ -20,8 +20,8 @@
 use super::ode_backend::{psa_world, step_world};
 use super::ode_body::{planar_state, project_onto_plane, reset_body, OdeBodyTemplate};
 use super::{
-    validate_thrust, BodyState, MassProperties, PhysicsError, PlanarState, PlaneConstraint, RigidBodyModel,
-    StepGuard, StepSettings, Stepper,
+    validate_thrust, BodyState, MassProperties, PhysicsError, PlanarState, PlaneConstraint, RigidBodyModel, StepGuard,
+    StepSettings, Stepper,
 };
 use crate::ode::{Body, Joint, World};
 
