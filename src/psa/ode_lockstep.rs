@@ -31,8 +31,11 @@ use crate::numeric::{clamp_unit, NoiseSource};
 use crate::physics::{wrap_angle, BackendKind, OdeFleet, PlanarState};
 use crate::rng::Stream;
 
-/// Networks flown in one ODE world at a time.
-pub const ODE_LOCKSTEP: usize = 16;
+/// Networks flown in one ODE world at a time. From 8 bodies a world up,
+/// the cost per network-step is flat (`psa-esp bench`, docs/performance.md);
+/// 32 cuts the baseline ESP's 400 networks a generation into 12 batches and
+/// a tail of 16, which two threads share evenly.
+pub const ODE_LOCKSTEP: usize = 32;
 
 /// Evaluates batches of networks on one task on ODE, in lockstep (see the
 /// module documentation). Owns an ODE world: not `Send`, one per thread.
