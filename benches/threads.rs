@@ -1,5 +1,5 @@
 //! 1 against 2 threads (criterion): PSA network evaluations on every path
-//! (ode, native scalar, native batched on each SIMD level the CPU has,
+//! (ode one world per network and in lockstep, native scalar, native batched on each SIMD level the CPU has,
 //! rapier); `evolve`, one baseline ESP run of task 3 on `native`; and
 //! `replicate`, a grid of 12 runs on `native` (baseline and max-credit, 3
 //! tasks, 2 seeds) with 50-trial robustness tests. The speed-up is the ratio of a

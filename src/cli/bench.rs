@@ -1,8 +1,10 @@
 //! `psa-esp bench`: in one run, ns per physics step of every backend
 //! (interleaved so that machine noise hits them alike), ns per
-//! network-step and evaluations per second of every evaluation path (ode,
-//! native scalar, native batched on each SIMD level, rapier) on 1 and 2
-//! threads, the logistic function alone on the batched path (the bulk of
+//! network-step and evaluations per second of every evaluation path (ode
+//! one world per network and in lockstep, native scalar, native batched on
+//! each SIMD level, rapier) on 1 and 2 threads, the ODE lockstep path by
+//! bodies per world (see [`super::bench_ode`]), the logistic function
+//! alone on the batched path (the bulk of
 //! its arithmetic), and the 2-thread speed-up and algorithm overhead of
 //! `evolve` and `replicate` (see [`super::bench_runs`]).
 
@@ -47,14 +49,17 @@ pub struct BenchArgs {
     pub json: bool,
 }
 
-/// A way of evaluating networks: a backend, and on `native` the scalar
-/// reference or the batched path on one SIMD level.
+/// A way of evaluating networks: a backend, on `native` the scalar
+/// reference or the batched path on one SIMD level, on `ode` one world per
+/// network or the lockstep path (many bodies in one world).
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct EvaluationPath {
     /// The physics backend.
     pub backend: BackendKind,
     /// The batched path's SIMD level; `None` for the scalar path.
     pub simd: Option<SimdLevel>,
+    /// On `ode`, the lockstep path; otherwise one world per network.
+    pub ode_lockstep: bool,
 }
 
 impl EvaluationPath {
@@ -63,23 +68,37 @@ impl EvaluationPath {
         match (self.backend, self.simd) {
             (BackendKind::Native, None) => "native scalar".into(),
             (BackendKind::Native, Some(level)) => format!("native batched {level}"),
+            (BackendKind::Ode, _) if self.ode_lockstep => "ode lockstep".into(),
+            (BackendKind::Ode, _) => "ode one world each".into(),
             (backend, _) => backend.name().into(),
         }
     }
 
-    /// ode, native scalar, native batched on every level the CPU has, rapier.
+    /// ode one world per network and in lockstep, native scalar, native
+    /// batched on every level the CPU has, rapier.
     pub fn all() -> Vec<EvaluationPath> {
         let mut paths = Vec::new();
         for backend in BackendKind::available() {
-            paths.push(EvaluationPath { backend, simd: None });
+            let path = EvaluationPath {
+                backend,
+                simd: None,
+                ode_lockstep: false,
+            };
+            paths.push(path);
+            if backend == BackendKind::Ode {
+                paths.push(EvaluationPath {
+                    ode_lockstep: true,
+                    ..path
+                });
+            }
             if backend == BackendKind::Native {
                 paths.extend(
                     SimdLevel::ALL
                         .into_iter()
                         .filter(|l| l.is_supported())
                         .map(|level| EvaluationPath {
-                            backend,
                             simd: Some(level),
+                            ..path
                         }),
                 );
             }
@@ -93,7 +112,9 @@ impl EvaluationPath {
             backend: self.backend,
             ..PsaSettings::default()
         };
-        Ok(PsaEvaluator::new(settings, Task::StopRotation)?.with_batching(self.simd))
+        Ok(PsaEvaluator::new(settings, Task::StopRotation)?
+            .with_batching(self.simd)
+            .with_ode_lockstep(self.ode_lockstep))
     }
 }
 
@@ -304,6 +325,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    let lockstep = super::bench_ode::lockstep_by_world_size(&networks, args.rounds)?;
     let best_batched = evaluations
         .iter()
         .filter(|e| e.path.simd.is_some())
@@ -332,6 +354,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             "ode_path": ode_path,
             "networks_per_round": args.networks,
             "psa_evaluation": evaluations,
+            "ode_lockstep_by_world_size": lockstep,
             "simd_level_in_use": SimdLevel::detect(),
             "logistic_function": logistic,
             "evolve": evolve,
@@ -387,6 +410,14 @@ pub fn run(args: BenchArgs) -> Result<i32> {
                 e.ns_per_network_step_1_thread
             );
         }
+        let sizes: Vec<String> = lockstep
+            .iter()
+            .map(|t| format!("{} {:.1}", t.bodies, t.ns_per_network_step))
+            .collect();
+        say!(
+            "ode lockstep, ns/network-step by bodies per world (1 thread, median): {}",
+            sizes.join(", ")
+        );
         say!(
             "logistic function alone (blocks of {LANES} values, best SIMD level): {:.2} ns per value; the {} of a network-step take {:.1} % of the batched network-step",
             logistic.ns_per_value,

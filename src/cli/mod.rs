@@ -9,6 +9,7 @@ macro_rules! say {
 }
 
 pub mod bench;
+pub mod bench_ode;
 pub mod bench_runs;
 mod crosscheck;
 mod evolve;

@@ -54,6 +54,14 @@ pub struct GridArgs {
     /// Physics backend.
     #[arg(long, value_enum)]
     pub backend: Option<BackendKind>,
+    /// Fly every champion again on ode after its run on native: its fitness
+    /// and robustness results must be bit-identical, recorded in run.json
+    /// (default: on for --preset paper on native).
+    #[arg(long, overrides_with = "no_ode_check")]
+    pub ode_check: bool,
+    /// Skip the ODE check of --ode-check.
+    #[arg(long, overrides_with = "ode_check")]
+    pub no_ode_check: bool,
     /// Trials of each robustness test (at most 1,000,000).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_TRIALS))]
     pub robustness_trials: Option<u64>,
@@ -119,6 +127,11 @@ impl GridArgs {
         spec.generations = self.generations.map_or(spec.generations, |g| g as usize);
         spec.backend = self.backend.unwrap_or(spec.backend);
         spec.robustness_trials = self.robustness_trials.map_or(spec.robustness_trials, |t| t as usize);
+        spec.ode_check = match (self.ode_check, self.no_ode_check) {
+            (true, _) => true,
+            (_, true) => false,
+            _ => self.preset == GridPreset::Paper && spec.backend == BackendKind::Native,
+        };
         Ok(spec)
     }
 

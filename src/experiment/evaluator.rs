@@ -9,34 +9,39 @@ use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
 use crate::psa::batch::LANES;
-use crate::psa::{BatchRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
+use crate::psa::ode_lockstep::ODE_LOCKSTEP;
+use crate::psa::{BatchRunner, OdeLockstepRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use crate::rng::{Stream, StreamFamily};
 
-/// The environment variable that picks the `native` evaluation path:
-/// `scalar`, or a SIMD level (`portable`, `avx2`, `avx512`) for the batched
-/// path; unset, the best level of the CPU. It changes speed only: every
-/// path gives the same results, bit for bit.
+/// The environment variable that picks the evaluation path: `scalar` (one
+/// network at a time, on `ode` one world per network), or a SIMD level
+/// (`portable`, `avx2`, `avx512`) for `native`'s batched path; unset, the
+/// best level of the CPU, and on `ode` the lockstep path. It changes speed
+/// only: every path gives the same results, bit for bit.
 pub const SIMD_VARIABLE: &str = "PSA_ESP_SIMD";
 
 /// Scores a network by its fitness on a task (in % of the theoretical
 /// maximum, the mean over `settings.trials` trials). Each worker thread
-/// owns one physics world, reused between evaluations. On the `native`
+/// owns its physics worlds, reused between evaluations. On the `native`
 /// backend, networks are evaluated in lockstep by the batched SIMD path
-/// ([`BatchRunner`]), which gives the scalar path's results bit for bit.
+/// ([`BatchRunner`]); on `ode`, in lockstep as bodies of one world
+/// ([`OdeLockstepRunner`]). Both give the scalar path's results bit for bit.
 #[derive(Debug, Clone)]
 pub struct PsaEvaluator {
     settings: PsaSettings,
     task: Task,
     /// The batched runner, built once and used by every worker thread.
     batch: Option<BatchRunner>,
+    /// Whether `ode` runs batches in lockstep (each worker its own world).
+    ode_lockstep: bool,
 }
 
-/// A worker thread's state: its scalar runner, which owns the thread's
-/// physics world. With the batched path it is made when first needed (only
-/// to evaluate one network on its own); the batched runner holds no state
-/// of its own and is shared by every thread.
+/// A worker thread's state: its runners, which own the thread's physics
+/// worlds, each made when first needed. The batched `native` runner holds
+/// no state of its own and is shared by every thread.
 pub struct PsaWorker {
     scalar: Option<TrialRunner>,
+    lockstep: Option<OdeLockstepRunner>,
 }
 
 impl PsaEvaluator {
@@ -57,10 +62,16 @@ impl PsaEvaluator {
             BackendKind::Native => Some(BatchRunner::new(&settings, task)?),
             _ => None,
         };
-        let evaluator = PsaEvaluator { settings, task, batch };
+        let ode_lockstep = OdeLockstepRunner::supports(&settings);
+        let evaluator = PsaEvaluator {
+            settings,
+            task,
+            batch,
+            ode_lockstep,
+        };
         Ok(match std::env::var(SIMD_VARIABLE) {
             Err(_) => evaluator,
-            Ok(choice) if choice == "scalar" => evaluator.with_batching(None),
+            Ok(choice) if choice == "scalar" => evaluator.with_batching(None).with_ode_lockstep(false),
             Ok(choice) => {
                 evaluator.with_batching(Some(choice.parse().map_err(|e| {
                     anyhow::anyhow!("{SIMD_VARIABLE}={choice:?}: {e} (or scalar for the scalar path)")
@@ -83,6 +94,15 @@ impl PsaEvaluator {
         };
         self
     }
+
+    /// The same evaluator with `ode`'s lockstep path on (where the settings
+    /// allow it: see [`OdeLockstepRunner::supports`]) or off (one world per
+    /// network, the reference): for benchmarks and cross-checks (both give
+    /// the same results). Other backends are unchanged.
+    pub fn with_ode_lockstep(mut self, on: bool) -> PsaEvaluator {
+        self.ode_lockstep = on && OdeLockstepRunner::supports(&self.settings);
+        self
+    }
 }
 
 impl Evaluator for PsaEvaluator {
@@ -94,12 +114,14 @@ impl Evaluator for PsaEvaluator {
         THRUSTER_COUNT
     }
     fn worker(&self) -> Result<PsaWorker> {
+        // ODE worlds belong to their thread: make the runners here (or later, on it).
         Ok(PsaWorker {
-            // ODE worlds belong to their thread: make the scalar runner here.
-            scalar: match self.batch {
-                None => Some(TrialRunner::new(&self.settings, self.task)?),
-                Some(_) => None,
+            scalar: if self.batch.is_none() && !self.ode_lockstep {
+                Some(TrialRunner::new(&self.settings, self.task)?)
+            } else {
+                None
             },
+            lockstep: None,
         })
     }
     fn evaluate(&self, worker: &mut PsaWorker, network: &Network, rng: &mut Stream) -> Result<f64> {
@@ -108,6 +130,8 @@ impl Evaluator for PsaEvaluator {
     fn batch_size(&self) -> usize {
         if self.batch.is_some() {
             LANES
+        } else if self.ode_lockstep {
+            ODE_LOCKSTEP
         } else {
             1
         }
@@ -122,12 +146,17 @@ impl Evaluator for PsaEvaluator {
         range: Range<usize>,
         streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
-        match &self.batch {
-            Some(batch) => {
-                let mut rngs: Vec<Stream> = range.clone().map(|j| streams.stream(j)).collect();
-                Ok(batch.evaluate(networks, range, &mut rngs)?)
-            }
-            None => evaluate_each(self, worker, networks, range, streams),
+        let rngs = || -> Vec<Stream> { range.clone().map(|j| streams.stream(j)).collect() };
+        if let Some(batch) = &self.batch {
+            return Ok(batch.evaluate(networks, range.clone(), &mut rngs())?);
         }
+        if self.ode_lockstep {
+            if worker.lockstep.is_none() {
+                worker.lockstep = Some(OdeLockstepRunner::new(&self.settings, self.task)?);
+            }
+            let lockstep = worker.lockstep.as_mut().expect("just made");
+            return Ok(lockstep.evaluate(networks, range.clone(), &mut rngs())?);
+        }
+        evaluate_each(self, worker, networks, range, streams)
     }
 }

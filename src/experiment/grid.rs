@@ -62,6 +62,12 @@ pub struct GridSpec {
     pub backend: BackendKind,
     /// Trials of each robustness test.
     pub robustness_trials: usize,
+    /// Whether every champion is flown again on `ode` after its run, where
+    /// its fitness and robustness results must be bit-identical (grids on
+    /// `native` only; see [`super::ode_check`]). On by default for the
+    /// paper preset on `native`.
+    #[serde(default)]
+    pub ode_check: bool,
     /// Settings laid over every configuration of the grid before its own
     /// change (a TOML document, as `--config` files are written).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -108,6 +114,7 @@ impl GridSpec {
             generations,
             backend,
             robustness_trials,
+            ode_check: preset == GridPreset::Paper && backend == BackendKind::Native,
             overrides: None,
         }
     }
@@ -140,6 +147,12 @@ impl GridSpec {
         }
         if !self.backend.is_available() {
             bail!("backend {} is not available in this build", self.backend);
+        }
+        if self.ode_check && self.backend != BackendKind::Native {
+            bail!(
+                "the ODE check flies champions evolved on native again on ode; this grid runs on {} (use --backend native or --no-ode-check)",
+                self.backend
+            );
         }
         for &config in &self.configs {
             self.run_config(config)?;

@@ -6,6 +6,7 @@ mod config;
 mod evaluator;
 pub mod grid;
 pub mod lockstep;
+pub mod ode_check;
 pub mod replicate;
 pub mod report;
 pub mod robustness;

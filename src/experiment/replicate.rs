@@ -16,9 +16,10 @@ use rayon::prelude::*;
 use super::claim::{claim, Attempt, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
 use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
 use super::lockstep::{replicate_lockstep, Executor};
+use super::ode_check::check_on_ode;
 use super::robustness::test_robustness;
 use super::shard::Shard;
-use super::{run_evolution, EvolveOutcome};
+use super::{run_evolution, EvolveOutcome, RunFiles};
 use crate::psa::NetworkFile;
 
 /// Stream key of the run seeds.
@@ -160,18 +161,25 @@ pub fn describe(spec: &GridSpec) -> String {
     let configs: Vec<&str> = spec.configs.iter().map(|c| c.name()).collect();
     let tasks: Vec<String> = spec.tasks.iter().map(|t| t.to_string()).collect();
     format!(
-        "configs {}, tasks {}, seeds {}, {} generations, backend {}, {} robustness trials",
+        "configs {}, tasks {}, seeds {}, {} generations, backend {}{}, {} robustness trials",
         configs.join(","),
         tasks.join(","),
         spec.seeds,
         spec.generations,
         spec.backend,
+        if spec.ode_check {
+            " (every champion checked on ode)"
+        } else {
+            ""
+        },
         spec.robustness_trials
     )
 }
 
-/// Runs one run of the grid and its robustness tests; `robustness.json`,
-/// written last, marks it finished.
+/// Runs one run of the grid and its robustness tests, and with
+/// `spec.ode_check` flies its champion again on `ode` (recorded in
+/// `run.json`; a difference stops the run with an error naming it);
+/// `robustness.json`, written last, marks it finished.
 pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
     let config = spec.run_config(key.config)?;
@@ -183,7 +191,7 @@ pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun>
 
 /// A run's robustness tests, once its evolution is written; writes
 /// `robustness.json`, which marks it finished.
-pub(super) fn test_and_mark(dir: &Path, spec: &GridSpec, key: &RunKey, outcome: EvolveOutcome) -> Result<FinishedRun> {
+pub(super) fn test_and_mark(dir: &Path, spec: &GridSpec, key: &RunKey, mut outcome: EvolveOutcome) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
     let config = spec.run_config(key.config)?;
     let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
@@ -194,6 +202,20 @@ pub(super) fn test_and_mark(dir: &Path, spec: &GridSpec, key: &RunKey, outcome: 
         spec.robustness_trials,
         outcome.seed,
     )?;
+    if spec.ode_check {
+        let check = check_on_ode(
+            &champion,
+            key.task,
+            &config.problem,
+            spec.robustness_trials,
+            outcome.seed,
+            &robustness,
+        )
+        .with_context(|| format!("run {}: the ODE check", folder.display()))?;
+        outcome.ode_check = Some(check.clone());
+        outcome.save(&RunFiles::in_dir(&folder).summary)?;
+        check.verify(&folder.display().to_string())?;
+    }
     let mut json = serde_json::to_string_pretty(&robustness)?;
     json.push('\n');
     crate::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())?;

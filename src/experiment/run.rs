@@ -69,6 +69,19 @@ pub struct EvolveOutcome {
     pub finished: String,
     /// Wall-clock seconds.
     pub seconds: f64,
+    /// The ODE check of a grid run on `native` (see
+    /// [`super::ode_check`]), added once the check ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ode_check: Option<super::ode_check::OdeCheck>,
+}
+
+impl EvolveOutcome {
+    /// Writes the outcome to `path` (a run's `run.json`) atomically.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let mut json = serde_json::to_string_pretty(self)?;
+        json.push('\n');
+        write_atomic(path, json.as_bytes())
+    }
 }
 
 /// The header line of `records.csv`.
@@ -223,10 +236,9 @@ impl RunStart {
             started: self.started,
             finished: crate::provenance::now_rfc3339(),
             seconds,
+            ode_check: None,
         };
-        let mut json = serde_json::to_string_pretty(&outcome)?;
-        json.push('\n');
-        write_atomic(&files.summary, json.as_bytes())?;
+        outcome.save(&files.summary)?;
         Ok(outcome)
     }
 }

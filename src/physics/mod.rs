@@ -7,6 +7,8 @@ mod guard;
 mod model;
 mod native;
 mod ode_backend;
+mod ode_body;
+mod ode_fleet;
 #[cfg(feature = "rapier")]
 mod rapier_backend;
 
@@ -24,6 +26,7 @@ pub use guard::{StepGuard, ENGINE_LIMIT};
 pub use model::{MassPart, MassProperties, RigidBodyModel, Thruster};
 pub use native::{NativeBackend, PlanarBody, PlanarState, RotationRule};
 pub use ode_backend::OdeBackend;
+pub use ode_fleet::{OdeFleet, MAX_FLEET};
 #[cfg(feature = "rapier")]
 pub use rapier_backend::RapierBackend;
 

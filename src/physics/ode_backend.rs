@@ -4,18 +4,12 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
+use super::ode_body::{planar_state, project_onto_plane, reset_body, OdeBodyTemplate};
 use super::{
-    validate_thrust, BackendKind, BodyState, MassPart, MassProperties, PhysicsBackend, PhysicsError, PlanarState,
+    validate_thrust, BackendKind, BodyState, MassProperties, PhysicsBackend, PhysicsError, PlanarState,
     PlaneConstraint, RigidBodyModel, StepGuard, StepSettings, Stepper,
 };
-use crate::ode::{BareOdeLoop, BareStepper, Body, Joint, Mass, World};
-
-/// A thruster's force at full command and its mount relative to the centre of mass.
-#[derive(Debug, Clone, Copy)]
-struct MountedThruster {
-    force: [f64; 3],
-    arm: [f64; 3],
-}
+use crate::ode::{BareOdeLoop, BareStepper, Body, Joint, World};
 
 /// The ODE backend. Not `Send`: build one per thread.
 pub struct OdeBackend {
@@ -23,28 +17,30 @@ pub struct OdeBackend {
     _plane_joint: Option<Joint>,
     body: Body,
     world: World,
-    thrusters: Vec<MountedThruster>,
+    template: OdeBodyTemplate,
     properties: MassProperties,
     settings: StepSettings,
     guard: StepGuard,
 }
 
-/// The composite mass of `model` built with ODE's own mass functions, before
-/// re-centring: each part's mass translated to its place, then added.
-fn composite_mass(model: &RigidBodyModel) -> Result<Mass, PhysicsError> {
-    let mut total: Option<Mass> = None;
-    for part in &model.parts {
-        let (mut mass, center) = match *part {
-            MassPart::Cylinder { radius, height, center } => (Mass::cylinder_z(model.density, radius, height)?, center),
-            MassPart::Cuboid { size, center } => (Mass::cuboid(model.density, size)?, center),
-        };
-        mass.translate([center[0], center[1], 0.0])?;
-        match &mut total {
-            Some(sum) => sum.add(&mass),
-            None => total = Some(mass),
-        }
+/// A world for PSA bodies stepped with `settings` (already validated):
+/// zero gravity, ODE's QuickStep iterations set.
+pub(super) fn psa_world(settings: &StepSettings) -> Result<World, PhysicsError> {
+    let world = World::new()?;
+    world.set_gravity([0.0, 0.0, 0.0])?;
+    world.set_quick_step_iterations(settings.quick_step_iterations)?;
+    Ok(world)
+}
+
+/// Advances `world` by one step of `settings` (validated at construction:
+/// dt > 0, never changed since).
+#[inline]
+pub(super) fn step_world(world: &World, settings: &StepSettings) -> Result<(), PhysicsError> {
+    match settings.stepper {
+        Stepper::Exact => world.step_prechecked(settings.dt)?,
+        Stepper::Quick => world.quick_step_prechecked(settings.dt)?,
     }
-    total.ok_or_else(|| PhysicsError::InvalidModel("the body has no mass parts".into()))
+    Ok(())
 }
 
 impl OdeBackend {
@@ -53,52 +49,15 @@ impl OdeBackend {
         model.validate()?;
         settings.validate()?;
         let guard = StepGuard::new(model, settings)?;
-        let world = World::new()?;
-        world.set_gravity([0.0, 0.0, 0.0])?;
-        world.set_quick_step_iterations(settings.quick_step_iterations)?;
-        let mut mass = composite_mass(model)?;
-        let center = mass.center();
-        // ODE requires the centre of mass at the body origin: shift the mass
-        // by -c, and the thruster mounts with it.
-        mass.translate([-center[0], -center[1], -center[2]])?;
-        let body = world.create_body()?;
-        body.set_mass(&mass)?;
-        body.set_gyroscopic_mode(settings.ode_gyroscopic);
-        let stored = body.mass();
-        let properties = MassProperties {
-            mass: stored.total(),
-            center,
-            inertia: stored.inertia(),
-        };
-        let plane_joint = match settings.plane_constraint {
-            PlaneConstraint::None => None,
-            PlaneConstraint::Plane2dJoint => Some(world.create_plane2d_joint(&body)?),
-        };
-        let thrusters = model
-            .thrusters
-            .iter()
-            .map(|t| MountedThruster {
-                force: [t.direction[0] * model.max_force, t.direction[1] * model.max_force, 0.0],
-                arm: [t.mount[0] - center[0], t.mount[1] - center[1], -center[2]],
-            })
-            .collect::<Vec<_>>();
-        // What `step` relies on to skip the wrapper's finiteness checks
-        // (already implied by a valid model, checked once to be sure).
-        if let Some(i) = thrusters
-            .iter()
-            .position(|t| !t.force.iter().chain(&t.arm).all(|v| v.is_finite()))
-        {
-            return Err(PhysicsError::InvalidModel(format!(
-                "thruster {i}: force {:?} or arm {:?} about the centre of mass is not finite",
-                thrusters[i].force, thrusters[i].arm
-            )));
-        }
+        let template = OdeBodyTemplate::new(model)?;
+        let world = psa_world(settings)?;
+        let (body, plane_joint) = template.create(&world, settings)?;
         Ok(OdeBackend {
             _plane_joint: plane_joint,
+            properties: template.properties(&body),
             body,
             world,
-            thrusters,
-            properties,
+            template,
             settings: *settings,
             guard,
         })
@@ -110,7 +69,7 @@ impl OdeBackend {
     /// the body's current state and skips the plane projection of
     /// [`PlaneConstraint::Plane2dJoint`].
     pub fn bare_loop<'a>(&'a self, thrust: &'a [Vec<f64>]) -> Result<BareOdeLoop<'a>, PhysicsError> {
-        let thrusters: Vec<_> = self.thrusters.iter().map(|t| (t.force, t.arm)).collect();
+        let thrusters: Vec<_> = self.template.thrusters.iter().map(|t| (t.force, t.arm)).collect();
         let stepper = match self.settings.stepper {
             Stepper::Exact => BareStepper::Exact,
             Stepper::Quick => BareStepper::Quick,
@@ -144,7 +103,7 @@ impl OdeBackend {
     ) -> Result<(Duration, Duration), PhysicsError> {
         let mut backend = OdeBackend::new(model, settings)?;
         for row in thrust {
-            validate_thrust(row, backend.thrusters.len())?;
+            validate_thrust(row, backend.template.thrusters.len())?;
         }
         let start = BodyState::default();
         let mut ours = Duration::MAX;
@@ -173,31 +132,6 @@ impl OdeBackend {
         }
         Ok((ours, bare))
     }
-
-    /// Removes any out-of-plane motion the Plane2D joint lets creep in:
-    /// keeps only the z rotation of the quaternion and of the angular
-    /// velocity, and z = 0, vz = 0. A no-op (bit for bit) when the body is
-    /// exactly planar already.
-    fn project_onto_plane(&self) -> Result<(), PhysicsError> {
-        let q = self.body.quaternion();
-        if q[1] != 0.0 || q[2] != 0.0 {
-            let norm = q[0].hypot(q[3]);
-            self.body.set_quaternion([q[0] / norm, 0.0, 0.0, q[3] / norm])?;
-        }
-        let w = self.body.angular_velocity();
-        if w[0] != 0.0 || w[1] != 0.0 {
-            self.body.set_angular_velocity([0.0, 0.0, w[2]])?;
-        }
-        let p = self.body.position();
-        if p[2] != 0.0 {
-            self.body.set_position([p[0], p[1], 0.0])?;
-        }
-        let v = self.body.linear_velocity();
-        if v[2] != 0.0 {
-            self.body.set_linear_velocity([v[0], v[1], 0.0])?;
-        }
-        Ok(())
-    }
 }
 
 impl PhysicsBackend for OdeBackend {
@@ -208,25 +142,11 @@ impl PhysicsBackend for OdeBackend {
     fn reset(&mut self, state: &BodyState) -> Result<(), PhysicsError> {
         state.validate()?;
         self.guard.check(&PlanarState::from_body_state(state))?;
-        let half = 0.5 * state.heading;
-        self.body.set_position([state.x, state.y, 0.0])?;
-        self.body.set_quaternion([half.cos(), 0.0, 0.0, half.sin()])?;
-        self.body.set_linear_velocity([state.vx, state.vy, 0.0])?;
-        self.body.set_angular_velocity([0.0, 0.0, state.omega])?;
-        Ok(())
+        reset_body(&self.body, state)
     }
 
     fn planar_state(&self) -> PlanarState<f64> {
-        let p = self.body.position();
-        let q = self.body.quaternion();
-        let v = self.body.linear_velocity();
-        let w = self.body.angular_velocity();
-        PlanarState {
-            position: [p[0], p[1]],
-            velocity: [v[0], v[1]],
-            quaternion: [q[0], q[3]],
-            omega: w[2],
-        }
+        planar_state(&self.body)
     }
 
     /// The hot path (issue 6): no allocation, and no check beyond
@@ -238,18 +158,12 @@ impl PhysicsBackend for OdeBackend {
     /// prechecked ODE calls require, so the wrapper does not check them
     /// again.
     fn step(&mut self, thrust: &[f64]) -> Result<(), PhysicsError> {
-        validate_thrust(thrust, self.thrusters.len())?;
+        validate_thrust(thrust, self.template.thrusters.len())?;
         self.guard.check(&self.planar_state())?;
-        for (t, &u) in self.thrusters.iter().zip(thrust) {
-            let force = [t.force[0] * u, t.force[1] * u, t.force[2] * u];
-            self.body.add_rel_force_at_rel_pos_prechecked(force, t.arm);
-        }
-        match self.settings.stepper {
-            Stepper::Exact => self.world.step_prechecked(self.settings.dt)?,
-            Stepper::Quick => self.world.quick_step_prechecked(self.settings.dt)?,
-        }
+        self.template.push(&self.body, thrust);
+        step_world(&self.world, &self.settings)?;
         if self.settings.plane_constraint == PlaneConstraint::Plane2dJoint {
-            self.project_onto_plane()?;
+            project_onto_plane(&self.body)?;
         }
         Ok(())
     }
