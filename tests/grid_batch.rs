@@ -65,6 +65,70 @@ fn shards_together_give_the_single_process_grid() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("3 runs, 3 already finished, 0 run now"));
 }
 
+/// A sweep of two variants (`esp.stagnation` 3 and 5) of baseline on tasks
+/// 1 and 2, one seed: 4 runs.
+fn two_variant_sweep(out: &std::path::Path) -> Vec<String> {
+    let mut a = tiny_grid("sweep", out);
+    let tasks = a.iter().position(|x| x == "--tasks").unwrap();
+    a[tasks + 1] = "1,2".into();
+    a.extend(["--vary".into(), "esp.stagnation=3,5".into()]);
+    a
+}
+
+#[test]
+fn a_sharded_sweep_gives_the_single_process_sweep_and_one_runs_csv() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (single, sharded) = (tmp.path().join("single"), tmp.path().join("sharded"));
+    let o = psa_esp(&args(&two_variant_sweep(&single)));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let mut ran = Vec::new();
+    for shard in ["1/2", "0/2"] {
+        let mut a = two_variant_sweep(&sharded);
+        a.extend(["--shard".into(), shard.into()]);
+        let o = psa_esp(&args(&a));
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        // The shard splits the sweep's whole run order: 2 of its 4 runs each.
+        let lines = finished_lines(&o.stderr);
+        assert_eq!(lines.len(), 2, "{}", String::from_utf8_lossy(&o.stderr));
+        ran.extend(lines.into_iter().map(|l| format!("{shard} {l}")));
+    }
+    let mut variants: Vec<_> = std::fs::read_dir(single.join("variants"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    variants.sort();
+    assert_eq!(variants.len(), 2, "{variants:?}");
+    for variant in &variants {
+        assert_same_runs(
+            &single.join("variants").join(variant),
+            &sharded.join("variants").join(variant),
+        );
+    }
+
+    // The sweep's report writes one runs.csv over both variants, with the
+    // varied setting's value in a column of its own.
+    let o = psa_esp(&["report", sharded.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(sharded.join("runs.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("variant,esp.stagnation,configuration,task,seed,run_seed,"),
+        "{csv}"
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let cells: Vec<(&str, &str, &str)> = rows.iter().map(|r| (r[0], r[1], r[3])).collect();
+    let (v0, v1) = (variants[0].to_str().unwrap(), variants[1].to_str().unwrap());
+    assert_eq!(
+        cells,
+        [(v0, "3", "1"), (v0, "3", "2"), (v1, "5", "1"), (v1, "5", "2")],
+        "{csv}"
+    );
+}
+
 #[test]
 fn a_bad_shard_is_refused_by_name() {
     let tmp = tempfile::tempdir().unwrap();

@@ -17,6 +17,7 @@ use super::render::num;
 use super::tables::Report;
 use super::{GridResults, Metric};
 use crate::experiment::grid::grid_file;
+use crate::experiment::runs_table::{sweep_runs_csv, VariantRuns, RUNS_CSV};
 use crate::experiment::sweep::{variant_dir, SweepSpec};
 use crate::experiment::{GridConfig, Preset};
 use crate::psa::Task;
@@ -109,8 +110,14 @@ impl VariantSummary {
 impl SweepReport {
     /// Reads every variant of the sweep in `dir`.
     pub fn load(dir: &Path) -> Result<SweepReport> {
+        Ok(Self::load_with_results(dir)?.0)
+    }
+
+    /// [`SweepReport::load`], keeping each variant's results (in variant order).
+    fn load_with_results(dir: &Path) -> Result<(SweepReport, Vec<GridResults>)> {
         let sweep = SweepSpec::load(dir)?;
         let mut variants = Vec::new();
+        let mut grids = Vec::new();
         for variant in sweep.variants() {
             let folder = variant_dir(dir, &variant);
             // A variant the sweep has not reached yet counts as a grid without runs.
@@ -126,6 +133,7 @@ impl SweepReport {
                 }
             };
             variants.push(VariantSummary::of(variant.name, variant.settings, &results));
+            grids.push(results);
         }
         let sensitivity = sweep
             .vary
@@ -154,14 +162,15 @@ impl SweepReport {
         let select = |keep: &dyn Fn(&[Verdict]) -> bool| -> Vec<String> {
             order.iter().filter(|c| keep(&judged(c))).cloned().collect()
         };
-        Ok(SweepReport {
+        let report = SweepReport {
             hold_everywhere: select(&|v| !v.is_empty() && v.iter().all(|x| *x == Verdict::Reproduced)),
             fail_everywhere: select(&|v| !v.is_empty() && v.iter().all(|x| *x == Verdict::NotReproduced)),
             depend: select(&|v| v.contains(&Verdict::Reproduced) && v.contains(&Verdict::NotReproduced)),
             sweep,
             variants,
             sensitivity,
-        })
+        };
+        Ok((report, grids))
     }
 
     /// The report as Markdown.
@@ -305,14 +314,28 @@ fn flips(variants: &[VariantSummary], key: &str) -> Vec<String> {
     flipped
 }
 
-/// Reads the sweep in `dir` and writes `sweep-report.md` and
-/// `sweep-report.json` into it; returns the report and the files.
+/// Reads the sweep in `dir` and writes `sweep-report.md`,
+/// `sweep-report.json` and `runs.csv` (every variant's finished runs, a
+/// column per varied setting) into it; returns the report and the files.
 pub fn write_sweep_report(dir: &Path) -> Result<(SweepReport, String, Vec<PathBuf>)> {
-    let report = SweepReport::load(dir)?;
+    let (report, grids) = SweepReport::load_with_results(dir)?;
     let markdown = report.markdown();
     let md_path = dir.join("sweep-report.md");
     crate::io::write_atomic(&md_path, markdown.as_bytes())?;
     let json_path = dir.join("sweep-report.json");
     crate::io::write_json(&json_path, &report)?;
-    Ok((report, markdown, vec![md_path, json_path]))
+    let keys: Vec<String> = report.sweep.vary.iter().map(|v| v.key.clone()).collect();
+    let variants: Vec<VariantRuns> = report
+        .variants
+        .iter()
+        .zip(&grids)
+        .map(|(variant, grid)| VariantRuns {
+            name: &variant.name,
+            dir: &grid.dir,
+            runs: &grid.runs,
+        })
+        .collect();
+    let runs_path = dir.join(RUNS_CSV);
+    crate::io::write_atomic(&runs_path, sweep_runs_csv(&keys, &variants)?.as_bytes())?;
+    Ok((report, markdown, vec![md_path, json_path, runs_path]))
 }
