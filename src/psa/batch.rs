@@ -267,13 +267,35 @@ fn accumulate<const N: usize>(
     }
 }
 
-/// The kernel of width `$n`, with or without noise, as a function with the
-/// attributes given (a `multiversion` target list, or none for the portable
-/// build), evaluating the neurons' logistic functions `$group` neurons at a
-/// time (see [`fly`]).
+/// The kernel of width `$n`, with or without noise, evaluating the neurons'
+/// logistic functions `$group` neurons at a time (see [`fly`]): compiled for
+/// the `multiversion` target `$target` when given, else for the build's
+/// baseline (the portable kernel).
+///
+/// `multiversion` compiles a target's function twice: for the target, and
+/// as a fallback for processors without its features. `run` never calls a
+/// target's kernel on such a processor (it runs the [`SimdLevel`] asked
+/// for, which the processor has), so the fallback is a call of the
+/// portable kernel (`match_target!` compiles only the arm of the clone's
+/// target): not a second and third copy of the whole flight for baseline
+/// x86-64, which were 12 of the 30 kernels the build compiled and about
+/// half of their machine code.
 macro_rules! kernel {
-    ($(#[$attr:meta])* $name:ident, $n:expr, $group:expr, $noisy:expr) => {
-        $(#[$attr])*
+    ($name:ident, $target:tt, $n:expr, $group:expr, $noisy:expr) => {
+        #[multiversion(targets($target))]
+        fn $name(
+            flight: &Flight<$n>,
+            state: &mut PlanarState<Lanes<$n>>,
+            target: &[Lanes<$n>; 3],
+            noise: &mut NoiseSource<Words<$n>>,
+        ) -> (Lanes<$n>, LaneMask<$n>) {
+            multiversion::target::match_target! {
+                $target => fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise),
+                _ => portable(flight, state, target, noise),
+            }
+        }
+    };
+    ($name:ident, $n:expr, $group:expr, $noisy:expr) => {
         fn $name(
             flight: &Flight<$n>,
             state: &mut PlanarState<Lanes<$n>>,
@@ -295,19 +317,13 @@ macro_rules! kernels {
             use super::*;
 
             kernel!(
-                #[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl"))]
                 avx512,
+                "x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl",
                 $n,
                 $g512,
                 $noisy
             );
-            kernel!(
-                #[multiversion(targets("x86_64+avx2+fma"))]
-                avx2,
-                $n,
-                $g256,
-                $noisy
-            );
+            kernel!(avx2, "x86_64+avx2+fma", $n, $g256, $noisy);
             kernel!(portable, $n, 1, $noisy);
 
             pub(super) fn run(
