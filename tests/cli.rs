@@ -183,14 +183,14 @@ fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
     use psa_esp::psa::{NetworkFile, PsaSettings, Task};
     let dir = tempfile::tempdir().unwrap();
     let net_path = dir.path().join("damper.json");
-    NetworkFile::new(
-        &spin_damper(),
-        Task::StopRotation,
-        &PsaSettings::default(),
-        serde_json::Map::new(),
-    )
-    .save(&net_path)
-    .unwrap();
+    // The damper is made for task 1's earlier start spin of 1 rad/s (at the
+    // default 2 rad/s its full thrust pushes the PSA out of the box before
+    // the spin stops); the file records that model, and replay flies on it.
+    let mut model = PsaSettings::default();
+    model.tasks.task1_spin = 1.0;
+    NetworkFile::new(&spin_damper(), Task::StopRotation, &model, serde_json::Map::new())
+        .save(&net_path)
+        .unwrap();
     let out = dir.path().join("replay");
     let o = psa_esp(&[
         "replay",
