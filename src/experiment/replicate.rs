@@ -189,9 +189,16 @@ pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun>
     test_and_mark(dir, spec, key, outcome)
 }
 
-/// A run's robustness tests, once its evolution is written; writes
-/// `robustness.json`, which marks it finished.
-pub(super) fn test_and_mark(dir: &Path, spec: &GridSpec, key: &RunKey, mut outcome: EvolveOutcome) -> Result<FinishedRun> {
+/// A run's robustness tests, once its evolution is written, and its ODE
+/// check when `spec.ode_check` (recorded in `run.json`; a difference is an
+/// error naming the run); then writes `robustness.json`, which marks it
+/// finished.
+pub(super) fn test_and_mark(
+    dir: &Path,
+    spec: &GridSpec,
+    key: &RunKey,
+    mut outcome: EvolveOutcome,
+) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
     let config = spec.run_config(key.config)?;
     let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
