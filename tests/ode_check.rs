@@ -2,12 +2,11 @@
 //! `ode`, its fitness and robustness results recorded in `run.json` and
 //! required bit-identical; on by default for the paper preset on `native`.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn psa_esp(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_psa-esp")).args(args).output().unwrap()
-}
+use std::path::Path;
+
+use common::{psa_esp, run_file_paths};
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
@@ -15,19 +14,11 @@ fn json(path: &Path) -> serde_json::Value {
 
 /// Every `run.json` under `dir`.
 fn summaries(dir: &Path) -> Vec<serde_json::Value> {
-    let mut found = Vec::new();
-    let mut stack = vec![dir.join("runs")];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.ends_with("run.json") {
-                found.push(json(&path));
-            }
-        }
-    }
-    found
+    run_file_paths(dir)
+        .iter()
+        .filter(|p| p.ends_with("run.json"))
+        .map(|p| json(p))
+        .collect()
 }
 
 /// The check of one run: identical, with a finite value for each quantity on both backends.

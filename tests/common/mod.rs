@@ -2,7 +2,7 @@
 //! grid's results for byte-for-byte comparison.
 #![allow(dead_code)] // each test file uses its own share
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Runs `psa-esp` with `args`.
@@ -37,10 +37,8 @@ pub fn tiny_grid(command: &str, out: &Path) -> Vec<String> {
     .collect()
 }
 
-/// Every file of every run folder, by path relative to `dir`, with
-/// `run.json`'s times (`started`, `finished`, `seconds`: when, not what)
-/// taken out. A claim left behind would show up here too.
-pub fn run_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+/// The path of every file in every run folder of the grid in `dir`.
+pub fn run_file_paths(dir: &Path) -> Vec<PathBuf> {
     let mut files = Vec::new();
     let mut stack = vec![dir.join("runs")];
     while let Some(d) = stack.pop() {
@@ -48,19 +46,31 @@ pub fn run_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
             let path = entry.unwrap().path();
             if path.is_dir() {
                 stack.push(path);
-                continue;
+            } else {
+                files.push(path);
             }
-            let mut bytes = std::fs::read(&path).unwrap();
-            if path.file_name().unwrap() == "run.json" {
-                let mut summary: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
-                let fields = summary.as_object_mut().unwrap();
-                for time in ["started", "finished", "seconds"] {
-                    assert!(fields.remove(time).is_some(), "run.json without {time}");
-                }
-                bytes = serde_json::to_vec_pretty(&summary).unwrap();
-            }
-            files.push((path.strip_prefix(dir).unwrap().display().to_string(), bytes));
         }
+    }
+    files.sort();
+    files
+}
+
+/// Every file of every run folder, by path relative to `dir`, with
+/// `run.json`'s times (`started`, `finished`, `seconds`: when, not what)
+/// taken out. A claim left behind would show up here too.
+pub fn run_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
+    for path in run_file_paths(dir) {
+        let mut bytes = std::fs::read(&path).unwrap();
+        if path.file_name().unwrap() == "run.json" {
+            let mut summary: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+            let fields = summary.as_object_mut().unwrap();
+            for time in ["started", "finished", "seconds"] {
+                assert!(fields.remove(time).is_some(), "run.json without {time}");
+            }
+            bytes = serde_json::to_vec_pretty(&summary).unwrap();
+        }
+        files.push((path.strip_prefix(dir).unwrap().display().to_string(), bytes));
     }
     files.sort();
     files
