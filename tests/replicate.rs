@@ -1,13 +1,13 @@
 //! The replication grid end to end: resume after kill -9, damaged and
 //! foreign run folders, and the report of a tiny grid.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
-fn psa_esp(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_psa-esp")).args(args).output().unwrap()
-}
+use common::{psa_esp, run_file_paths};
 
 /// A small grid: 3 configurations x task 1 x 4 seeds, on one thread.
 fn grid_args(out: &Path) -> Vec<String> {
@@ -36,25 +36,17 @@ fn grid_args(out: &Path) -> Vec<String> {
 /// Every result file of every run folder, by relative path (provenance
 /// times in run.json excluded: they say when, not what).
 fn results(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files = Vec::new();
-    let mut stack = vec![dir.join("runs")];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if ["records.csv", "champion.json", "robustness.json", "config.toml"]
+    run_file_paths(dir)
+        .into_iter()
+        .filter(|path| {
+            ["records.csv", "champion.json", "robustness.json", "config.toml"]
                 .contains(&path.file_name().unwrap().to_str().unwrap())
-            {
-                files.push((
-                    path.strip_prefix(dir).unwrap().display().to_string(),
-                    std::fs::read(&path).unwrap(),
-                ));
-            }
-        }
-    }
-    files.sort();
-    files
+        })
+        .map(|path| {
+            let bytes = std::fs::read(&path).unwrap();
+            (path.strip_prefix(dir).unwrap().display().to_string(), bytes)
+        })
+        .collect()
 }
 
 fn finished_runs(dir: &Path) -> usize {
@@ -114,27 +106,20 @@ fn a_grid_killed_part_way_resumes_to_the_same_results() {
 
 /// Every run's `run.json` without its times (started, finished, seconds).
 fn summaries(dir: &Path) -> Vec<(String, serde_json::Value)> {
-    let mut files = Vec::new();
-    let mut stack = vec![dir.join("runs")];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.ends_with("run.json") {
-                let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-                for time in ["started", "finished", "seconds"] {
-                    json.as_object_mut()
-                        .unwrap()
-                        .remove(time)
-                        .expect("run.json has its times");
-                }
-                files.push((path.strip_prefix(dir).unwrap().display().to_string(), json));
+    run_file_paths(dir)
+        .into_iter()
+        .filter(|path| path.ends_with("run.json"))
+        .map(|path| {
+            let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+            for time in ["started", "finished", "seconds"] {
+                json.as_object_mut()
+                    .unwrap()
+                    .remove(time)
+                    .expect("run.json has its times");
             }
-        }
-    }
-    files.sort_by(|a, b| a.0.cmp(&b.0));
-    files
+            (path.strip_prefix(dir).unwrap().display().to_string(), json)
+        })
+        .collect()
 }
 
 #[test]
