@@ -291,7 +291,7 @@ fn start_states_and_targets_are_as_specified() {
         (s2, g2),
         (
             BodyState {
-                omega: 1.0,
+                omega: 1.25,
                 ..BodyState::default()
             },
             Target {

@@ -92,7 +92,8 @@ pub struct TaskSettings {
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
     /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
-    /// turning when the trial starts. `[fitted]` 1.0 (docs/model.md)
+    /// turning when the trial starts. `[fitted]` 1.25: the paper's Table 1
+    /// level for task 2 and its burst totals (docs/model.md, sweep S11)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
@@ -112,7 +113,7 @@ impl Default for TaskSettings {
         TaskSettings {
             task1_spin: 2.0,
             task2_target_heading: FRAC_PI_2,
-            task2_spin: 1.0,
+            task2_spin: 1.25,
             task2_velocity: [0.0, 0.0],
             task3_speed: 0.3,
             task3_distance: 0.40,
