@@ -1,7 +1,8 @@
 //! The batched (SIMD) evaluation path against the scalar reference: the
 //! same fitness, bit for bit, on thousands of seeded random networks, on
 //! every task, with noise, random starts and several trials, and on every
-//! SIMD level (the portable fallback included).
+//! SIMD level (the portable fallback included); and the `cuda` path's
+//! trial kernel, built for the host, against the same reference.
 
 use psa_esp::network::Network;
 use psa_esp::numeric::SimdLevel;
@@ -239,4 +240,60 @@ fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
     ] {
         assert_eq!(run(level, threads), reference, "{level:?} on {threads} threads");
     }
+}
+
+/// Fitness of networks `seeds` by the `cuda` path's kernel built for the host.
+fn kernel_on_host(settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>) -> Vec<f64> {
+    let networks: Vec<Network> = seeds.clone().map(random_network).collect();
+    let refs: Vec<&Network> = networks.iter().collect();
+    psa_esp::psa::cuda::evaluate_with(
+        settings,
+        task,
+        &refs[..],
+        0..refs.len(),
+        &mut streams(seeds),
+        psa_esp::psa::cuda::fly_on_host,
+    )
+    .unwrap()
+}
+
+#[test]
+fn the_cuda_kernel_built_for_the_host_computes_the_scalar_paths_bits() {
+    let clean = native(PsaSettings::default());
+    for task in Task::ALL {
+        let seeds = 9000..9400;
+        let (scalar, _) = both_paths(&clean, task, seeds.clone(), SimdLevel::Portable);
+        assert_bit_identical(
+            &scalar,
+            &kernel_on_host(&clean, task, seeds),
+            &format!("clean task {task}"),
+        );
+    }
+    let noisy = native(PsaSettings {
+        trials: 3,
+        random_init: true,
+        noise: NoiseSettings {
+            input_sd: 0.05,
+            output_sd: 0.1,
+        },
+        ..PsaSettings::default()
+    });
+    for task in [Task::StopRotation, Task::StopAtPosition] {
+        let seeds = 9500..9700;
+        let (scalar, _) = both_paths(&noisy, task, seeds.clone(), SimdLevel::Portable);
+        assert_bit_identical(
+            &scalar,
+            &kernel_on_host(&noisy, task, seeds),
+            &format!("noisy task {task}"),
+        );
+    }
+    let mut original = native(PsaSettings::default());
+    original.fitness.kind = FitnessKind::Original;
+    original.steps = 300;
+    let (scalar, _) = both_paths(&original, Task::Turn, 9800..9900, SimdLevel::Portable);
+    assert_bit_identical(
+        &scalar,
+        &kernel_on_host(&original, Task::Turn, 9800..9900),
+        "original fitness",
+    );
 }

@@ -24,7 +24,7 @@ pub use crosscheck::{
 };
 pub use guard::{StepGuard, ENGINE_LIMIT};
 pub use model::{MassPart, MassProperties, RigidBodyModel, Thruster};
-pub use native::{NativeBackend, PlanarBody, PlanarState, RotationRule};
+pub use native::{NativeBackend, PlanarBody, PlanarState, RotationRule, StepConstants, ThrusterConstants};
 pub use ode_backend::OdeBackend;
 pub use ode_fleet::{OdeFleet, MAX_FLEET};
 #[cfg(feature = "rapier")]

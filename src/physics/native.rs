@@ -58,7 +58,43 @@ enum Support {
     Both,
 }
 
+/// What [`PlanarBody::step`] computes with: see [`PlanarBody::constants`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepConstants {
+    /// The thrusters, in command order.
+    pub thrusters: Vec<ThrusterConstants>,
+    /// 1 / mass (1/kg).
+    pub inv_mass: f64,
+    /// 1 / the moment of inertia about z (1/(kg m^2)).
+    pub inv_inertia_z: f64,
+    /// The step (s).
+    pub dt: f64,
+}
+
+/// One thruster of [`StepConstants`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThrusterConstants {
+    /// Body-frame force at full command (N).
+    pub force: [f64; 2],
+    /// Mount relative to the centre of mass (m).
+    pub arm: [f64; 2],
+    /// Which components of `force` the rotation multiplies: 0 x only, 1 y
+    /// only, 2 both (a step skips the products with a zero component).
+    pub force_support: i32,
+    /// The same for `arm`.
+    pub arm_support: i32,
+}
+
 impl Support {
+    /// The code of [`ThrusterConstants`]: 0 x, 1 y, 2 both.
+    fn code(self) -> i32 {
+        match self {
+            Support::X => 0,
+            Support::Y => 1,
+            Support::Both => 2,
+        }
+    }
+
     fn of(v: [f64; 2]) -> Support {
         match (v[0] != 0.0, v[1] != 0.0) {
             (true, false) => Support::X,
@@ -182,6 +218,26 @@ impl PlanarBody {
     /// Number of thrusters.
     pub fn thruster_count(&self) -> usize {
         self.thrusters.len()
+    }
+
+    /// The constants [`PlanarBody::step`] uses, for a kernel that repeats
+    /// it elsewhere (the `cuda` path's `trial.cu`).
+    pub fn constants(&self) -> StepConstants {
+        StepConstants {
+            thrusters: self
+                .thrusters
+                .iter()
+                .map(|t| ThrusterConstants {
+                    force: t.force,
+                    arm: t.arm,
+                    force_support: t.force_support.code(),
+                    arm_support: t.arm_support.code(),
+                })
+                .collect(),
+            inv_mass: self.inv_mass,
+            inv_inertia_z: self.inv_inertia_z,
+            dt: self.dt,
+        }
     }
 
     /// The velocities after one step of `thrust` (one command per thruster,

@@ -4,6 +4,7 @@
 
 pub mod batch;
 pub mod body;
+pub mod cuda;
 pub mod fitness;
 pub mod limits;
 pub mod network_file;

@@ -1,0 +1,287 @@
+//! The trial kernel of the `cuda` evaluation path and its host side.
+//!
+//! `trial.cu` flies one trial per thread: the batched `native` kernel
+//! ([`super::batch`]) written out in C for one network, operation for
+//! operation, in double precision, every `mul_add` an explicit `fma`.
+//! NVRTC compiles it for the GPU with `--fmad=false`; the build compiles the
+//! same file with the host C compiler (`-ffp-contract=off`), and
+//! [`fly_on_host`] runs it, so the tests hold the kernel's arithmetic to
+//! `native` bit for bit on any machine, with or without a GPU.
+//!
+//! The host draws what the trials need from each network's own stream, in
+//! the scalar path's order ([`prepare`]): the random start, then the seed of
+//! the noise source, trial by trial; the kernel gets the start, the target
+//! and the noise generator's state. [`evaluate_with`] turns the trials'
+//! points into each network's fitness and re-runs a network whose flight
+//! ended non-finite on the scalar path, which names the error, as the
+//! batched path does.
+
+use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
+use super::{FitnessKind, SlowingRule, Task, INPUT_COUNT, THRUSTER_COUNT};
+use crate::network::NetworkSet;
+use crate::physics::{BackendKind, PlanarBody, PlanarState};
+use crate::rng::{expand, Stream};
+
+/// The kernel's source (CUDA C that is also plain C).
+pub const KERNEL_SOURCE: &str = include_str!("trial.cu");
+
+/// The kernel's name in [`KERNEL_SOURCE`].
+pub const KERNEL_NAME: &str = "psa_trials";
+
+/// The settings every thread shares: `PsaParams` of `trial.cu`, field for field.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, zerocopy::IntoBytes, zerocopy::Immutable)]
+pub struct KernelParams {
+    position_scale: f64,
+    velocity_scale: f64,
+    heading_scale: f64,
+    angular_velocity_scale: f64,
+    bias: f64,
+    input_sd: f64,
+    output_sd: f64,
+    box_half_width: f64,
+    heading_window: f64,
+    spin_window: f64,
+    position_points: f64,
+    heading_points: f64,
+    force: [[f64; 2]; THRUSTER_COUNT],
+    arm: [[f64; 2]; THRUSTER_COUNT],
+    inv_mass: f64,
+    inv_inertia_z: f64,
+    dt: f64,
+    force_support: [i32; THRUSTER_COUNT],
+    arm_support: [i32; THRUSTER_COUNT],
+    steps: i32,
+    noisy: i32,
+    incremental: i32,
+    signed_slowing: i32,
+}
+
+/// One trial: `PsaTrial` of `trial.cu`, field for field.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, zerocopy::IntoBytes, zerocopy::Immutable)]
+pub struct KernelTrial {
+    position: [f64; 2],
+    velocity: [f64; 2],
+    quaternion: [f64; 2],
+    omega: f64,
+    target: [f64; 3],
+    noise_state: [u64; 4],
+    weights: i32,
+    hidden: i32,
+}
+
+/// Everything one launch needs: the shared settings, the networks'
+/// weights (the active hidden neurons' genes, network after network) and
+/// the trials, network by network, `trials_per_network` each.
+#[derive(Debug, Clone)]
+pub struct TrialBatch {
+    /// The shared settings.
+    pub params: KernelParams,
+    /// The genes of every active hidden neuron, input weights then output weights.
+    pub weights: Vec<f64>,
+    /// The trials: network `j`'s trial `t` at `j * trials_per_network + t`.
+    pub trials: Vec<KernelTrial>,
+    /// Trials per network (the settings' `trials`).
+    pub trials_per_network: usize,
+}
+
+/// The kernel's output for a batch: each trial's points, and whether its
+/// velocity and spin ended finite.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrialPoints {
+    /// Points per trial, in the batch's order.
+    pub points: Vec<f64>,
+    /// 1 where the flight ended finite, 0 where not.
+    pub finite: Vec<i32>,
+}
+
+impl KernelParams {
+    /// The parameters of `settings` (already validated for the task) on `body`.
+    pub fn new(settings: &PsaSettings, body: &PlanarBody) -> Result<KernelParams, PsaError> {
+        let constants = body.constants();
+        if constants.thrusters.len() != THRUSTER_COUNT {
+            return Err(PsaError::Setting(format!(
+                "the cuda kernel flies {THRUSTER_COUNT} thrusters, the body has {}",
+                constants.thrusters.len()
+            )));
+        }
+        let steps = i32::try_from(settings.steps)
+            .map_err(|_| PsaError::Setting(format!("{} steps are too many for the cuda kernel", settings.steps)))?;
+        let t = &constants.thrusters;
+        let (s, f) = (&settings.sensors, &settings.fitness);
+        Ok(KernelParams {
+            position_scale: s.position_scale,
+            velocity_scale: s.velocity_scale,
+            heading_scale: s.heading_scale,
+            angular_velocity_scale: s.angular_velocity_scale,
+            bias: s.bias,
+            input_sd: settings.noise.input_sd,
+            output_sd: settings.noise.output_sd,
+            box_half_width: f.box_half_width,
+            heading_window: f.heading_window,
+            spin_window: f.spin_window,
+            position_points: f.position_points,
+            heading_points: f.heading_points,
+            force: std::array::from_fn(|i| t[i].force),
+            arm: std::array::from_fn(|i| t[i].arm),
+            inv_mass: constants.inv_mass,
+            inv_inertia_z: constants.inv_inertia_z,
+            dt: constants.dt,
+            force_support: std::array::from_fn(|i| t[i].force_support),
+            arm_support: std::array::from_fn(|i| t[i].arm_support),
+            steps,
+            noisy: settings.noise.is_active().into(),
+            incremental: (f.kind == FitnessKind::Incremental).into(),
+            signed_slowing: (f.slowing == SlowingRule::Signed).into(),
+        })
+    }
+}
+
+/// The batch for networks `range` of `networks` on `task`, drawing each
+/// trial's start and noise seed from `rngs[i]` for network `range.start + i`
+/// in the scalar path's order.
+///
+/// # Panics
+/// If `range` and `rngs` differ in length.
+pub fn prepare<S: NetworkSet + ?Sized>(
+    settings: &PsaSettings,
+    body: &PlanarBody,
+    task: Task,
+    networks: &S,
+    range: std::ops::Range<usize>,
+    rngs: &mut [Stream],
+) -> Result<TrialBatch, PsaError> {
+    assert_eq!(range.len(), rngs.len(), "one stream per network");
+    let params = KernelParams::new(settings, body)?;
+    let mut weights = Vec::new();
+    let mut trials = Vec::with_capacity(range.len() * settings.trials);
+    for (j, rng) in range.zip(rngs.iter_mut()) {
+        let (inputs, outputs) = networks.shape(j);
+        TrialRunner::check_shape(inputs, outputs)?;
+        let offset = weights.len();
+        let mut hidden: usize = 0;
+        for k in (0..networks.hidden(j)).filter(|&k| !networks.is_lesioned(j, k)) {
+            weights.extend_from_slice(&networks.neuron(j, k)[..INPUT_COUNT + THRUSTER_COUNT]);
+            hidden += 1;
+        }
+        let too_big = |what: &str| PsaError::Setting(format!("the cuda kernel's batch is too large ({what})"));
+        let offset = i32::try_from(offset).map_err(|_| too_big("weights"))?;
+        let hidden = i32::try_from(hidden).map_err(|_| too_big("hidden neurons"))?;
+        for _ in 0..settings.trials {
+            let (start, target) = settings.tasks.start_and_target(task, settings.random_init, rng);
+            start.validate()?;
+            let state = PlanarState::from_body_state(&start);
+            trials.push(KernelTrial {
+                position: state.position,
+                velocity: state.velocity,
+                quaternion: state.quaternion,
+                omega: state.omega,
+                target: [target.x, target.y, target.heading],
+                noise_state: expand(settings.noise.draw_seed(rng)),
+                weights: offset,
+                hidden,
+            });
+        }
+    }
+    Ok(TrialBatch {
+        params,
+        weights,
+        trials,
+        trials_per_network: settings.trials,
+    })
+}
+
+/// The fitness of networks `range` of `networks` on `task`, in % of the
+/// theoretical maximum, their trials flown by `fly` (the host build,
+/// [`fly_on_host`], or a GPU): exactly what [`TrialRunner::evaluate`]
+/// gives network `range.start + i` with stream `rngs[i]`, as long as `fly`
+/// computes what `trial.cu` says. A network with a non-finite flight is
+/// re-run on the scalar path from where its stream stood, which reports
+/// the error.
+///
+/// # Panics
+/// If `range` and `rngs` differ in length.
+pub fn evaluate_with<S: NetworkSet + ?Sized>(
+    settings: &PsaSettings,
+    task: Task,
+    networks: &S,
+    range: std::ops::Range<usize>,
+    rngs: &mut [Stream],
+    fly: impl FnOnce(&TrialBatch) -> Result<TrialPoints, PsaError>,
+) -> Result<Vec<f64>, PsaError> {
+    settings.validate_for(task)?;
+    if settings.backend != BackendKind::Native {
+        return Err(PsaError::Setting(format!(
+            "the cuda kernel repeats the native backend's physics only, not {}",
+            settings.backend
+        )));
+    }
+    let body = PlanarBody::new(&settings.body.model()?, &settings.physics)?;
+    let positions: Vec<u128> = rngs.iter().map(|r| r.get_word_pos()).collect();
+    let batch = prepare(settings, &body, task, networks, range.clone(), rngs)?;
+    let flown = fly(&batch)?;
+    let maximum = settings.fitness.maximum(settings.steps);
+    let per = batch.trials_per_network;
+    let mut fitness = Vec::with_capacity(range.len());
+    for (i, j) in range.enumerate() {
+        let trials = i * per..(i + 1) * per;
+        if flown.finite[trials.clone()].iter().all(|&f| f != 0) {
+            let scores: Vec<f64> = flown.points[trials].iter().map(|p| 100.0 * p / maximum).collect();
+            fitness.push(mean_of_trials(&scores));
+        } else {
+            rngs[i].set_word_pos(positions[i]);
+            let network = networks.network(j);
+            fitness.push(TrialRunner::new(settings, task)?.evaluate(&network, &mut rngs[i])?);
+        }
+    }
+    Ok(fitness)
+}
+
+/// Flies `batch` with the kernel's code compiled for the host
+/// (`psa-trial-host`, built by `build.rs`), one trial after another: the
+/// GPU's arithmetic on the CPU, for checking the kernel without a GPU.
+pub fn fly_on_host(batch: &TrialBatch) -> Result<TrialPoints, PsaError> {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    use zerocopy::IntoBytes;
+    let count = batch.trials.len();
+    let failed = |why: String| PsaError::Setting(format!("the host build of the cuda kernel: {why}"));
+    let header = [
+        i32::try_from(count).map_err(|_| failed(format!("{count} trials are too many")))?,
+        i32::try_from(batch.weights.len()).map_err(|_| failed("too many weights".into()))?,
+    ];
+    let mut input = Vec::new();
+    input.extend_from_slice(header.as_bytes());
+    input.extend_from_slice(batch.params.as_bytes());
+    input.extend_from_slice(batch.weights.as_bytes());
+    input.extend_from_slice(batch.trials.as_bytes());
+    let mut child = Command::new(env!("PSA_ESP_TRIAL_HOST"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| failed(e.to_string()))?;
+    let mut stdin = child.stdin.take().ok_or_else(|| failed("no standard input".into()))?;
+    // Written from a thread of its own, so that a full output pipe cannot
+    // stall the write.
+    let writer = std::thread::spawn(move || stdin.write_all(&input));
+    let output = child.wait_with_output().map_err(|e| failed(e.to_string()))?;
+    writer
+        .join()
+        .map_err(|_| failed("the writer panicked".into()))?
+        .map_err(|e| failed(e.to_string()))?;
+    if !output.status.success() || output.stdout.len() != count * 12 {
+        return Err(failed(format!("it ended with {}", output.status)));
+    }
+    let (points, finite) = output.stdout.split_at(count * 8);
+    Ok(TrialPoints {
+        points: points
+            .chunks_exact(8)
+            .map(|b| f64::from_ne_bytes(b.try_into().expect("8 bytes")))
+            .collect(),
+        finite: finite
+            .chunks_exact(4)
+            .map(|b| i32::from_ne_bytes(b.try_into().expect("4 bytes")))
+            .collect(),
+    })
+}

@@ -1,0 +1,342 @@
+/*
+ * One PSA trial per thread: the batched `native` kernel (src/psa/batch.rs,
+ * `fly`) written out for one network, operation for operation, in double
+ * precision. Compiled at run time by NVRTC with --fmad=false for the GPU,
+ * and by the host C compiler with -ffp-contract=off for the tests, which
+ * hold it to `native` bit for bit without a GPU. Every multiply-add below
+ * is an explicit fma() exactly where the Rust code calls mul_add; every
+ * other operation is a separately rounded IEEE operation, as in Rust.
+ *
+ * Plain C (no C++ features), so that both compilers take it.
+ */
+
+#ifdef __CUDACC_RTC__
+#define PSA_FN static __device__ __forceinline__
+#define PSA_CONST static __device__ const
+typedef unsigned long long psa_u64;
+#define PSA_BITS(x) ((psa_u64)__double_as_longlong(x))
+#define PSA_FROM_BITS(u) __longlong_as_double((long long)(u))
+#else
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+#define PSA_FN static inline
+#define PSA_CONST static const
+typedef uint64_t psa_u64;
+static inline psa_u64 psa_bits(double x) {
+    psa_u64 u;
+    memcpy(&u, &x, sizeof u);
+    return u;
+}
+static inline double psa_from_bits(psa_u64 u) {
+    double x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+#define PSA_BITS(x) psa_bits(x)
+#define PSA_FROM_BITS(u) psa_from_bits(u)
+#endif
+
+#define PSA_INPUTS 7
+#define PSA_THRUSTERS 4
+#define PSA_GENES (PSA_INPUTS + PSA_THRUSTERS)
+
+/* Which components of a thruster's force or mount are kept (physics/native.rs, Support). */
+#define PSA_SUPPORT_X 0
+#define PSA_SUPPORT_Y 1
+#define PSA_SUPPORT_BOTH 2
+
+/* The settings every thread shares; the Rust side is `cuda::KernelParams` (#[repr(C)]). */
+typedef struct {
+    double position_scale, velocity_scale, heading_scale, angular_velocity_scale, bias;
+    double input_sd, output_sd;
+    double box_half_width, heading_window, spin_window, position_points, heading_points;
+    double force[PSA_THRUSTERS][2];
+    double arm[PSA_THRUSTERS][2];
+    double inv_mass, inv_inertia_z, dt;
+    int force_support[PSA_THRUSTERS];
+    int arm_support[PSA_THRUSTERS];
+    int steps;
+    int noisy;        /* any noise configured (the batched kernel's NOISY) */
+    int incremental;  /* fitness: 1 incremental, 0 original */
+    int signed_slowing;
+} PsaParams;
+
+/* One trial's start and target; the Rust side is `cuda::KernelTrial` (#[repr(C)]). */
+typedef struct {
+    double position[2], velocity[2], quaternion[2], omega;
+    double target[3];
+    psa_u64 noise_state[4];
+    int weights;  /* offset of the network's first gene in the weight array */
+    int hidden;   /* its hidden neurons (lesioned ones left out) */
+} PsaTrial;
+
+#define PSA_PI 3.141592653589793
+#define PSA_TAU 6.283185307179586
+#define PSA_FRAC_PI_2 1.5707963267948966
+#define PSA_FRAC_PI_4 0.7853981633974483
+#define PSA_SQRT_2 1.4142135623730951
+#define PSA_LOG2_E 1.4426950408889634
+#define PSA_TWO_52 4503599627370496.0
+#define PSA_ROUNDER 6755399441055744.0
+#define PSA_LN2_HI 6.931471803691238e-1
+#define PSA_LN2_LO 1.9082149292705877e-10
+#define PSA_EXP_LIMIT 708.0
+#define PSA_TAN_PI_8 0.41421356237309503
+#define PSA_F64_MAX 1.7976931348623157e308
+#define PSA_ONE_BITS 0x3FF0000000000000ULL
+#define PSA_MANTISSA_BITS 0x000FFFFFFFFFFFFFULL
+
+PSA_CONST double PSA_EXP_Q[10] = {
+    2.5100375832561234e-8, 2.7620075879983367e-7, 2.7557268480310024e-6, 2.4801521322368692e-5,
+    1.9841269863040545e-4, 1.3888888917196719e-3, 8.333333333330065e-3,  4.1666666666624164e-2,
+    1.6666666666666669e-1, 5.000000000000001e-1,
+};
+PSA_CONST double PSA_LN_R[7] = {
+    1.4798198605116586e-1, 1.5313837699209373e-1, 1.818357216161805e-1, 2.2222198432149784e-1,
+    2.857142874366239e-1,  3.999999999940942e-1,  6.666666666666735e-1,
+};
+PSA_CONST double PSA_ATAN_S[11] = {
+    -1.917688711906226e-2, 3.923165829558719e-2, -5.08544973794026e-2,  5.85814891280221e-2,
+    -6.664511447381948e-2, 7.692183190826087e-2, -9.090904578123903e-2, 1.1111111015256361e-1,
+    -1.4285714284666542e-1, 1.999999999999552e-1, -3.333333333333333e-1,
+};
+PSA_CONST double PSA_SIN_QUARTER[9] = {
+    6.0669357311061955e-12, -6.688035109811468e-10, 5.692172921967927e-8,  -3.598843235212085e-6,
+    1.6044118478735983e-4,  -4.681754135318688e-3,  7.969262624616705e-2, -6.459640975062463e-1,
+    PSA_FRAC_PI_2,
+};
+PSA_CONST double PSA_COS_QUARTER[9] = {
+    6.565963114979473e-11, -6.386603083791852e-9, 4.710874778818172e-7,  -2.5202042373060607e-5,
+    9.192602748394266e-4,  -2.086348076335296e-2, 2.5366950790104803e-1, -1.2337005501361697,
+    1.0,
+};
+
+/* esp_neuroevolution::math::horner: acc = acc * x + c, fused. */
+PSA_FN double psa_horner(double x, const double *c, int n) {
+    double acc = c[0];
+    for (int i = 1; i < n; i++) acc = fma(acc, x, c[i]);
+    return acc;
+}
+
+/* esp_neuroevolution::math::exp2_int_of */
+PSA_FN double psa_exp2_int(double k) {
+    psa_u64 shifted = PSA_BITS(k + (PSA_TWO_52 + 1023.0));
+    return PSA_FROM_BITS((shifted - PSA_BITS(PSA_TWO_52)) << 52);
+}
+
+/* esp_neuroevolution::math::exp */
+PSA_FN double psa_exp(double x) {
+    if (x < -PSA_EXP_LIMIT) x = -PSA_EXP_LIMIT;
+    if (PSA_EXP_LIMIT < x) x = PSA_EXP_LIMIT;
+    double k = fma(x, PSA_LOG2_E, PSA_ROUNDER) - PSA_ROUNDER;
+    double r = fma(k, -PSA_LN2_LO, fma(k, -PSA_LN2_HI, x));
+    double e_r = 1.0 + fma(r * r, psa_horner(r, PSA_EXP_Q, 10), r);
+    return e_r * psa_exp2_int(k);
+}
+
+/* esp_neuroevolution::math::sigmoid */
+PSA_FN double psa_sigmoid(double x) { return 1.0 / (1.0 + psa_exp(-x)); }
+
+/* numeric::math::ln, with Real::split_exponent of numeric/mod.rs */
+PSA_FN double psa_ln(double x) {
+    psa_u64 bits = PSA_BITS(x);
+    double mantissa = PSA_FROM_BITS((bits & PSA_MANTISSA_BITS) | PSA_ONE_BITS);
+    double exponent = PSA_FROM_BITS((bits >> 52) | PSA_BITS(PSA_TWO_52)) - (PSA_TWO_52 + 1023.0);
+    int high = PSA_SQRT_2 < mantissa;
+    double m = high ? mantissa * 0.5 : mantissa;
+    double e = high ? exponent + 1.0 : exponent;
+    double f = m - 1.0;
+    double s = f / (2.0 + f);
+    double z = s * s;
+    double r = z * psa_horner(z, PSA_LN_R, 7);
+    double half_f_squared = 0.5 * f * f;
+    return e * PSA_LN2_HI - ((half_f_squared - (s * (half_f_squared + r) + e * PSA_LN2_LO)) - f);
+}
+
+/* numeric::math::atan2 */
+PSA_FN double psa_atan2(double y, double x) {
+    double ax = fabs(x), ay = fabs(y);
+    int steep = ax < ay;
+    double small = steep ? ax : ay, large = steep ? ay : ax;
+    int shifted = (large * PSA_TAN_PI_8) < small;
+    double numerator = shifted ? small - large : small;
+    double denominator = shifted ? small + large : large;
+    double t = denominator <= 0.0 ? 0.0 : numerator / denominator;
+    double z = t * t;
+    double base = shifted ? PSA_FRAC_PI_4 : 0.0;
+    double angle = base + fma(t * z, psa_horner(z, PSA_ATAN_S, 11), t);
+    angle = steep ? PSA_FRAC_PI_2 - angle : angle;
+    angle = x < 0.0 ? PSA_PI - angle : angle;
+    return copysign(angle, y);
+}
+
+/* numeric::math::fmod and wrap_angle (modulus TAU) */
+PSA_FN double psa_wrap_angle(double angle) {
+    double a = fabs(angle) < 2.0 * PSA_TAU
+                   ? (fabs(angle) < PSA_TAU ? angle : copysign(fabs(angle) - PSA_TAU, angle))
+                   : fmod(angle, PSA_TAU);
+    a = PSA_PI < a ? a - PSA_TAU : a;
+    return a <= -PSA_PI ? a + PSA_TAU : a;
+}
+
+/* numeric::math::clamp_unit */
+PSA_FN double psa_clamp_unit(double u) {
+    u = u < 0.0 ? 0.0 : u;
+    return 1.0 < u ? 1.0 : u;
+}
+
+/* numeric::normal: xoshiro256++ */
+PSA_FN psa_u64 psa_rotl(psa_u64 x, int k) { return (x << k) | (x >> (64 - k)); }
+PSA_FN psa_u64 psa_next_word(psa_u64 *s) {
+    psa_u64 word = psa_rotl(s[0] + s[3], 23) + s[0];
+    psa_u64 t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = psa_rotl(s[3], 45);
+    return word;
+}
+
+/* numeric::normal::NoiseSource::normal_pair (Box-Muller) */
+PSA_FN void psa_normal_pair(psa_u64 *state, double *a, double *b) {
+    psa_u64 radial = psa_next_word(state);
+    psa_u64 angular = psa_next_word(state);
+    double u = 2.0 - PSA_FROM_BITS((radial >> 12) | PSA_ONE_BITS);
+    double radius = sqrt(-2.0 * psa_ln(u));
+    double f = PSA_FROM_BITS((angular >> 12) | PSA_ONE_BITS) - 1.5;
+    double z = f * f;
+    double sine = f * psa_horner(z, PSA_SIN_QUARTER, 9);
+    double cosine = psa_horner(z, PSA_COS_QUARTER, 9);
+    radius = (angular & 1) ? -radius : radius;
+    int quarter = (int)((angular >> 1) & 1);
+    double x = quarter ? -sine : cosine;
+    double y = quarter ? cosine : sine;
+    *a = radius * x;
+    *b = radius * y;
+}
+
+/* NoiseSource::add_scaled */
+PSA_FN void psa_add_scaled(psa_u64 *state, double *values, int count, double sd) {
+    for (int i = 0; i < count; i += 2) {
+        double a, b;
+        psa_normal_pair(state, &a, &b);
+        values[i] = values[i] + sd * a;
+        if (i + 1 < count) values[i + 1] = values[i + 1] + sd * b;
+    }
+}
+
+/* physics::native::Support::rotate */
+PSA_FN void psa_rotate(int support, double r00, double r01, double r10, double r11, double x, double y, double *out) {
+    if (support == PSA_SUPPORT_X) {
+        out[0] = r00 * x;
+        out[1] = r10 * x;
+    } else if (support == PSA_SUPPORT_Y) {
+        out[0] = r01 * y;
+        out[1] = r11 * y;
+    } else {
+        out[0] = r00 * x + r01 * y;
+        out[1] = r10 * x + r11 * y;
+    }
+}
+
+/* One trial: its points; *finite says whether the velocity and spin ended finite. */
+PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial *trial, int *finite) {
+    double px = trial->position[0], py = trial->position[1];
+    double vx = trial->velocity[0], vy = trial->velocity[1];
+    double qw = trial->quaternion[0], qz = trial->quaternion[1];
+    double omega = trial->omega;
+    double tx = trial->target[0], ty = trial->target[1], th = trial->target[2];
+    psa_u64 noise[4] = {trial->noise_state[0], trial->noise_state[1], trial->noise_state[2], trial->noise_state[3]};
+    const double *genes = weights + trial->weights;
+    double points = 0.0;
+    double heading_error = psa_wrap_angle(psa_wrap_angle(2.0 * psa_atan2(qz, qw)) - th);
+    for (int step = 0; step < p->steps; step++) {
+        double inputs[PSA_INPUTS] = {
+            (px - tx) * p->position_scale,
+            (py - ty) * p->position_scale,
+            vx * p->velocity_scale,
+            vy * p->velocity_scale,
+            heading_error * p->heading_scale,
+            omega * p->angular_velocity_scale,
+            p->bias,
+        };
+        if (p->noisy && p->input_sd > 0.0) psa_add_scaled(noise, inputs, PSA_INPUTS - 1, p->input_sd);
+        double out[PSA_THRUSTERS] = {0.0, 0.0, 0.0, 0.0};
+        for (int k = 0; k < trial->hidden; k++) {
+            const double *w = genes + k * PSA_GENES;
+            double activation = w[0] * inputs[0];
+            for (int i = 1; i < PSA_INPUTS; i++) activation = fma(w[i], inputs[i], activation);
+            double h = psa_sigmoid(activation);
+            for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = fma(h, w[PSA_INPUTS + o], out[o]);
+        }
+        for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_sigmoid(out[o]);
+        if (p->noisy && p->output_sd > 0.0) psa_add_scaled(noise, out, PSA_THRUSTERS, p->output_sd);
+        for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_clamp_unit(out[o]);
+
+        /* PlanarBody::step: accelerate, then the quaternion. */
+        double previous_omega = omega;
+        double two_qz_qz = 2.0 * qz * qz;
+        double one_minus = 1.0 - two_qz_qz;
+        double r00 = one_minus, r01 = 2.0 * -(qw * qz), r10 = 2.0 * (qw * qz), r11 = one_minus;
+        double fx = 0.0, fy = 0.0, tau = 0.0;
+        for (int t = 0; t < PSA_THRUSTERS; t++) {
+            double wf[2], arm[2];
+            double u = out[t];
+            psa_rotate(p->force_support[t], r00, r01, r10, r11, p->force[t][0] * u, p->force[t][1] * u, wf);
+            psa_rotate(p->arm_support[t], r00, r01, r10, r11, p->arm[t][0], p->arm[t][1], arm);
+            fx = fx + wf[0];
+            fy = fy + wf[1];
+            tau = tau + (arm[0] * wf[1] - arm[1] * wf[0]);
+        }
+        double h = p->dt;
+        double h_inv_mass = h * p->inv_mass;
+        vx = vx + h_inv_mass * fx;
+        vy = vy + h_inv_mass * fy;
+        omega = omega + p->inv_inertia_z * (tau * h);
+        px = px + h * vx;
+        py = py + h * vy;
+        double half_w = 0.5 * omega;
+        double w = qw + h * (-half_w * qz);
+        double z = qz + h * (half_w * qw);
+        double inv_norm = 1.0 / sqrt(w * w + z * z);
+        qw = w * inv_norm;
+        qz = z * inv_norm;
+
+        heading_error = psa_wrap_angle(psa_wrap_angle(2.0 * psa_atan2(qz, qw)) - th);
+        /* FitnessSettings::points */
+        double ex = px - tx, ey = py - ty;
+        int in_box = fabs(ex) < p->box_half_width && fabs(ey) < p->box_half_width;
+        int on_heading = fabs(heading_error) < p->heading_window;
+        double earned;
+        if (p->incremental) {
+            double spin = fabs(omega);
+            int slowing = p->signed_slowing ? omega < previous_omega : spin < fabs(previous_omega);
+            int spin_ok = spin < p->spin_window || slowing;
+            double full = on_heading ? p->position_points + p->heading_points : p->position_points;
+            earned = in_box && spin_ok ? full : 0.0;
+        } else {
+            earned = in_box && on_heading ? p->position_points : 0.0;
+        }
+        points = points + earned;
+    }
+    *finite = fabs(vx) <= PSA_F64_MAX && fabs(vy) <= PSA_F64_MAX && fabs(omega) <= PSA_F64_MAX;
+    return points;
+}
+
+#ifdef __CUDACC_RTC__
+/* One thread per trial. */
+extern "C" __global__ void psa_trials(PsaParams params, const double *weights, const PsaTrial *trials, int count,
+                                      double *points, int *finite) {
+    int i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < count) points[i] = psa_fly(&params, weights, &trials[i], &finite[i]);
+}
+#else
+/* The same trials flown one after another on the host. */
+void psa_trials_host(const PsaParams *params, const double *weights, const PsaTrial *trials, int count, double *points,
+                     int *finite) {
+    for (int i = 0; i < count; i++) points[i] = psa_fly(params, weights, &trials[i], &finite[i]);
+}
+#endif
