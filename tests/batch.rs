@@ -34,6 +34,27 @@ fn native(settings: PsaSettings) -> PsaSettings {
     }
 }
 
+/// Noise on inputs and outputs, random starts and 3 trials an evaluation.
+fn noisy_settings() -> PsaSettings {
+    native(PsaSettings {
+        trials: 3,
+        random_init: true,
+        noise: NoiseSettings {
+            input_sd: 0.05,
+            output_sd: 0.1,
+        },
+        ..PsaSettings::default()
+    })
+}
+
+/// The paper's original fitness function, on 300 steps.
+fn original_fitness_settings() -> PsaSettings {
+    let mut original = native(PsaSettings::default());
+    original.fitness.kind = FitnessKind::Original;
+    original.steps = 300;
+    original
+}
+
 fn streams(seeds: std::ops::Range<u64>) -> Vec<Stream> {
     seeds.map(|s| stream(s, &[2])).collect()
 }
@@ -98,22 +119,12 @@ fn batched_fitness_equals_the_scalar_path_on_thousands_of_random_networks() {
 
 #[test]
 fn batched_fitness_equals_the_scalar_path_with_noise_random_starts_trials_and_the_original_fitness() {
-    let noisy = native(PsaSettings {
-        trials: 3,
-        random_init: true,
-        noise: NoiseSettings {
-            input_sd: 0.05,
-            output_sd: 0.1,
-        },
-        ..PsaSettings::default()
-    });
+    let noisy = noisy_settings();
     for task in [Task::StopRotation, Task::StopAtPosition] {
         let (scalar, batched) = both_paths(&noisy, task, 5000..5300, SimdLevel::detect());
         assert_bit_identical(&scalar, &batched, &format!("noisy task {task}"));
     }
-    let mut original = native(PsaSettings::default());
-    original.fitness.kind = FitnessKind::Original;
-    original.steps = 300;
+    let original = original_fitness_settings();
     let (scalar, batched) = both_paths(&original, Task::Turn, 7000..7300, SimdLevel::detect());
     assert_bit_identical(&scalar, &batched, "original fitness");
 }
@@ -269,15 +280,7 @@ fn the_cuda_kernel_built_for_the_host_computes_the_scalar_paths_bits() {
             &format!("clean task {task}"),
         );
     }
-    let noisy = native(PsaSettings {
-        trials: 3,
-        random_init: true,
-        noise: NoiseSettings {
-            input_sd: 0.05,
-            output_sd: 0.1,
-        },
-        ..PsaSettings::default()
-    });
+    let noisy = noisy_settings();
     for task in [Task::StopRotation, Task::StopAtPosition] {
         let seeds = 9500..9700;
         let (scalar, _) = both_paths(&noisy, task, seeds.clone(), SimdLevel::Portable);
@@ -287,9 +290,7 @@ fn the_cuda_kernel_built_for_the_host_computes_the_scalar_paths_bits() {
             &format!("noisy task {task}"),
         );
     }
-    let mut original = native(PsaSettings::default());
-    original.fitness.kind = FitnessKind::Original;
-    original.steps = 300;
+    let original = original_fitness_settings();
     let (scalar, _) = both_paths(&original, Task::Turn, 9800..9900, SimdLevel::Portable);
     assert_bit_identical(
         &scalar,
