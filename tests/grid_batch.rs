@@ -14,6 +14,19 @@ fn args(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()
 }
 
+/// The binary run with `a` and `--shard shard`.
+fn run_shard(mut a: Vec<String>, shard: &str) -> std::process::Output {
+    a.extend(["--shard".into(), shard.into()]);
+    psa_esp(&args(&a))
+}
+
+/// The binary run with `a`, which must succeed.
+fn succeed(a: &[&str]) -> std::process::Output {
+    let o = psa_esp(a);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
 /// A grid of 9 runs: baseline, max-credit and hill-climb on tasks 1-3, one seed.
 fn nine_runs(out: &std::path::Path) -> Vec<String> {
     let mut a = tiny_grid("replicate", out);
@@ -26,14 +39,11 @@ fn nine_runs(out: &std::path::Path) -> Vec<String> {
 fn shards_together_give_the_single_process_grid() {
     let tmp = tempfile::tempdir().unwrap();
     let (single, sharded) = (tmp.path().join("single"), tmp.path().join("sharded"));
-    let o = psa_esp(&args(&nine_runs(&single)));
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    succeed(&args(&nine_runs(&single)));
 
     let mut ran = Vec::new();
     for shard in ["2/3", "0/3", "1/3"] {
-        let mut a = nine_runs(&sharded);
-        a.extend(["--shard".into(), shard.into()]);
-        let o = psa_esp(&args(&a));
+        let o = run_shard(nine_runs(&sharded), shard);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let stdout = String::from_utf8_lossy(&o.stdout);
         assert!(stdout.contains(&format!("shard {shard}): 3 runs")), "{stdout}");
@@ -54,14 +64,11 @@ fn shards_together_give_the_single_process_grid() {
     assert_same_runs(&single, &sharded);
 
     // The report counts every shard's runs.
-    let o = psa_esp(&["report", sharded.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = succeed(&["report", sharded.to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("9 of 9 runs counted"));
 
     // A shard of a finished grid has nothing left to do.
-    let mut a = nine_runs(&sharded);
-    a.extend(["--shard".into(), "1/3".into()]);
-    let o = psa_esp(&args(&a));
+    let o = run_shard(nine_runs(&sharded), "1/3");
     assert!(String::from_utf8_lossy(&o.stdout).contains("3 runs, 3 already finished, 0 run now"));
 }
 
@@ -79,14 +86,11 @@ fn two_variant_sweep(out: &std::path::Path) -> Vec<String> {
 fn a_sharded_sweep_gives_the_single_process_sweep_and_one_runs_csv() {
     let tmp = tempfile::tempdir().unwrap();
     let (single, sharded) = (tmp.path().join("single"), tmp.path().join("sharded"));
-    let o = psa_esp(&args(&two_variant_sweep(&single)));
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    succeed(&args(&two_variant_sweep(&single)));
 
     let mut ran = Vec::new();
     for shard in ["1/2", "0/2"] {
-        let mut a = two_variant_sweep(&sharded);
-        a.extend(["--shard".into(), shard.into()]);
-        let o = psa_esp(&args(&a));
+        let o = run_shard(two_variant_sweep(&sharded), shard);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         // The shard splits the sweep's whole run order: 2 of its 4 runs each.
         let lines = finished_lines(&o.stderr);
@@ -108,8 +112,7 @@ fn a_sharded_sweep_gives_the_single_process_sweep_and_one_runs_csv() {
 
     // The sweep's report writes one runs.csv over both variants, with the
     // varied setting's value in a column of its own.
-    let o = psa_esp(&["report", sharded.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    succeed(&["report", sharded.to_str().unwrap()]);
     let csv = std::fs::read_to_string(sharded.join("runs.csv")).unwrap();
     let mut lines = csv.lines();
     assert!(
@@ -133,9 +136,7 @@ fn a_sharded_sweep_gives_the_single_process_sweep_and_one_runs_csv() {
 fn a_bad_shard_is_refused_by_name() {
     let tmp = tempfile::tempdir().unwrap();
     for (shard, says) in [("3/3", "below the count"), ("1", "INDEX/COUNT"), ("0/0", "[1,")] {
-        let mut a = tiny_grid("replicate", &tmp.path().join("g"));
-        a.extend(["--shard".into(), shard.into()]);
-        let o = psa_esp(&args(&a));
+        let o = run_shard(tiny_grid("replicate", &tmp.path().join("g")), shard);
         assert_eq!(o.status.code(), Some(2), "{shard}");
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(err.contains("--shard") && err.contains(says), "{shard}: {err}");
@@ -147,8 +148,7 @@ fn a_bad_shard_is_refused_by_name() {
 fn three_processes_on_one_folder_run_every_run_once() {
     let tmp = tempfile::tempdir().unwrap();
     let (single, shared) = (tmp.path().join("single"), tmp.path().join("shared"));
-    let o = psa_esp(&args(&nine_runs(&single)));
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    succeed(&args(&nine_runs(&single)));
 
     let children: Vec<_> = (0..3)
         .map(|_| {
@@ -204,8 +204,7 @@ fn runs_csv_and_the_json_files_keep_every_seed_exact() {
     let dir = tmp.path().join("grid");
     let o = psa_esp(&args(&tiny_grid("replicate", &dir)));
     assert!(o.status.success());
-    let o = psa_esp(&["report", dir.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    succeed(&["report", dir.to_str().unwrap()]);
 
     let csv = std::fs::read_to_string(dir.join("runs.csv")).unwrap();
     let mut lines = csv.lines();
