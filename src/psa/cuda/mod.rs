@@ -22,12 +22,6 @@ use crate::network::NetworkSet;
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::{expand, Stream};
 
-/// The kernel's source (CUDA C that is also plain C).
-pub const KERNEL_SOURCE: &str = include_str!("trial.cu");
-
-/// The kernel's name in [`KERNEL_SOURCE`].
-pub const KERNEL_NAME: &str = "psa_trials";
-
 /// The settings every thread shares: `PsaParams` of `trial.cu`, field for field.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, zerocopy::IntoBytes, zerocopy::Immutable)]
@@ -73,17 +67,15 @@ pub struct KernelTrial {
 
 /// Everything one launch needs: the shared settings, the networks'
 /// weights (the active hidden neurons' genes, network after network) and
-/// the trials, network by network, `trials_per_network` each.
+/// the trials, network by network, the settings' `trials` each.
 #[derive(Debug, Clone)]
 pub struct TrialBatch {
     /// The shared settings.
     pub params: KernelParams,
     /// The genes of every active hidden neuron, input weights then output weights.
     pub weights: Vec<f64>,
-    /// The trials: network `j`'s trial `t` at `j * trials_per_network + t`.
+    /// The trials: network `j`'s trial `t` at `j * trials + t`.
     pub trials: Vec<KernelTrial>,
-    /// Trials per network (the settings' `trials`).
-    pub trials_per_network: usize,
 }
 
 /// The kernel's output for a batch: each trial's points, and whether its
@@ -188,7 +180,6 @@ pub fn prepare<S: NetworkSet + ?Sized>(
         params,
         weights,
         trials,
-        trials_per_network: settings.trials,
     })
 }
 
@@ -222,7 +213,7 @@ pub fn evaluate_with<S: NetworkSet + ?Sized>(
     let batch = prepare(settings, &body, task, networks, range.clone(), rngs)?;
     let flown = fly(&batch)?;
     let maximum = settings.fitness.maximum(settings.steps);
-    let per = batch.trials_per_network;
+    let per = settings.trials;
     let mut fitness = Vec::with_capacity(range.len());
     for (i, j) in range.enumerate() {
         let trials = i * per..(i + 1) * per;
