@@ -4,60 +4,16 @@
 //! SIMD level (the portable fallback included); and the `cuda` path's
 //! trial kernel, built for the host, against the same reference.
 
+mod kernel_cases;
+
+use kernel_cases::{
+    assert_bit_identical, native, noisy_settings, original_fitness_settings, random_network, scalar_fitness, streams,
+};
 use psa_esp::network::Network;
 use psa_esp::numeric::SimdLevel;
-use psa_esp::physics::BackendKind;
 use psa_esp::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
-use psa_esp::psa::{BatchRunner, FitnessKind, NoiseSettings, PsaSettings, Task, TrialRunner};
-use psa_esp::rng::{stream, Stream};
-use rand::RngExt;
-
-/// A random 7-H-4 network: H in 1..=9, weights uniform in a range of scale
-/// 0.3 to 30 (from nearly linear to fully saturated units), and now and
-/// then a lesioned neuron.
-fn random_network(seed: u64) -> Network {
-    let mut rng = stream(seed, &[1]);
-    let hidden = rng.random_range(1..=9);
-    let scale = [0.3, 1.0, 3.0, 6.0, 30.0][rng.random_range(0..5)];
-    let genes = (0..hidden * 11).map(|_| rng.random_range(-scale..scale)).collect();
-    let mut network = Network::from_genes(7, 4, genes).unwrap();
-    if hidden > 1 && rng.random_bool(0.2) {
-        network.set_lesioned(rng.random_range(0..hidden), true);
-    }
-    network
-}
-
-fn native(settings: PsaSettings) -> PsaSettings {
-    PsaSettings {
-        backend: BackendKind::Native,
-        ..settings
-    }
-}
-
-/// Noise on inputs and outputs, random starts and 3 trials an evaluation.
-fn noisy_settings() -> PsaSettings {
-    native(PsaSettings {
-        trials: 3,
-        random_init: true,
-        noise: NoiseSettings {
-            input_sd: 0.05,
-            output_sd: 0.1,
-        },
-        ..PsaSettings::default()
-    })
-}
-
-/// The paper's original fitness function, on 300 steps.
-fn original_fitness_settings() -> PsaSettings {
-    let mut original = native(PsaSettings::default());
-    original.fitness.kind = FitnessKind::Original;
-    original.steps = 300;
-    original
-}
-
-fn streams(seeds: std::ops::Range<u64>) -> Vec<Stream> {
-    seeds.map(|s| stream(s, &[2])).collect()
-}
+use psa_esp::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
+use psa_esp::rng::stream;
 
 /// Fitness of networks `seeds` by the scalar path and by the batched path on `level`.
 fn both_paths(
@@ -66,13 +22,8 @@ fn both_paths(
     seeds: std::ops::Range<u64>,
     level: SimdLevel,
 ) -> (Vec<f64>, Vec<f64>) {
+    let scalar = scalar_fitness(settings, task, seeds.clone());
     let networks: Vec<Network> = seeds.clone().map(random_network).collect();
-    let mut runner = TrialRunner::new(settings, task).unwrap();
-    let scalar = networks
-        .iter()
-        .zip(streams(seeds.clone()))
-        .map(|(n, mut rng)| runner.evaluate(n, &mut rng).unwrap())
-        .collect();
     let refs: Vec<&Network> = networks.iter().collect();
     let batched = BatchRunner::new(settings, task)
         .unwrap()
@@ -80,22 +31,6 @@ fn both_paths(
         .evaluate(&refs[..], 0..refs.len(), &mut streams(seeds))
         .unwrap();
     (scalar, batched)
-}
-
-fn assert_bit_identical(scalar: &[f64], batched: &[f64], what: &str) {
-    assert_eq!(scalar.len(), batched.len());
-    let differing: Vec<usize> = (0..scalar.len())
-        .filter(|&i| scalar[i].to_bits() != batched[i].to_bits())
-        .collect();
-    assert!(
-        differing.is_empty(),
-        "{what}: {} of {} networks differ, first {:?}: scalar {} batched {}",
-        differing.len(),
-        scalar.len(),
-        differing.first(),
-        scalar[differing[0]],
-        batched[differing[0]]
-    );
 }
 
 #[test]
@@ -254,47 +189,7 @@ fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
 }
 
 /// Fitness of networks `seeds` by the `cuda` path's kernel built for the host.
-fn kernel_on_host(settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>) -> Vec<f64> {
-    let networks: Vec<Network> = seeds.clone().map(random_network).collect();
-    let refs: Vec<&Network> = networks.iter().collect();
-    psa_esp::psa::cuda::evaluate_with(
-        settings,
-        task,
-        &refs[..],
-        0..refs.len(),
-        &mut streams(seeds),
-        psa_esp::psa::cuda::fly_on_host,
-    )
-    .unwrap()
-}
-
 #[test]
 fn the_cuda_kernel_built_for_the_host_computes_the_scalar_paths_bits() {
-    let clean = native(PsaSettings::default());
-    for task in Task::ALL {
-        let seeds = 9000..9400;
-        let (scalar, _) = both_paths(&clean, task, seeds.clone(), SimdLevel::Portable);
-        assert_bit_identical(
-            &scalar,
-            &kernel_on_host(&clean, task, seeds),
-            &format!("clean task {task}"),
-        );
-    }
-    let noisy = noisy_settings();
-    for task in [Task::StopRotation, Task::StopAtPosition] {
-        let seeds = 9500..9700;
-        let (scalar, _) = both_paths(&noisy, task, seeds.clone(), SimdLevel::Portable);
-        assert_bit_identical(
-            &scalar,
-            &kernel_on_host(&noisy, task, seeds),
-            &format!("noisy task {task}"),
-        );
-    }
-    let original = original_fitness_settings();
-    let (scalar, _) = both_paths(&original, Task::Turn, 9800..9900, SimdLevel::Portable);
-    assert_bit_identical(
-        &scalar,
-        &kernel_on_host(&original, Task::Turn, 9800..9900),
-        "original fitness",
-    );
+    kernel_cases::assert_kernel_gives_the_scalar_paths_bits(psa_esp::psa::cuda::fly_on_host);
 }

@@ -1,0 +1,127 @@
+//! Random networks, settings and the scalar reference shared by the
+//! batched path's tests and the `cuda` kernel's (on the host and on a GPU).
+#![allow(dead_code)] // each test file uses its own share
+
+use psa_esp::network::Network;
+use psa_esp::physics::BackendKind;
+use psa_esp::psa::cuda::{evaluate_with, TrialBatch, TrialPoints};
+use psa_esp::psa::{FitnessKind, NoiseSettings, PsaError, PsaSettings, Task, TrialRunner};
+use psa_esp::rng::{stream, Stream};
+use rand::RngExt;
+
+/// A random 7-H-4 network: H in 1..=9, weights uniform in a range of scale
+/// 0.3 to 30 (from nearly linear to fully saturated units), and now and
+/// then a lesioned neuron.
+pub fn random_network(seed: u64) -> Network {
+    let mut rng = stream(seed, &[1]);
+    let hidden = rng.random_range(1..=9);
+    let scale = [0.3, 1.0, 3.0, 6.0, 30.0][rng.random_range(0..5)];
+    let genes = (0..hidden * 11).map(|_| rng.random_range(-scale..scale)).collect();
+    let mut network = Network::from_genes(7, 4, genes).unwrap();
+    if hidden > 1 && rng.random_bool(0.2) {
+        network.set_lesioned(rng.random_range(0..hidden), true);
+    }
+    network
+}
+
+/// `settings` on the `native` backend.
+pub fn native(settings: PsaSettings) -> PsaSettings {
+    PsaSettings {
+        backend: BackendKind::Native,
+        ..settings
+    }
+}
+
+/// Noise on inputs and outputs, random starts and 3 trials an evaluation.
+pub fn noisy_settings() -> PsaSettings {
+    native(PsaSettings {
+        trials: 3,
+        random_init: true,
+        noise: NoiseSettings {
+            input_sd: 0.05,
+            output_sd: 0.1,
+        },
+        ..PsaSettings::default()
+    })
+}
+
+/// The paper's original fitness function, on 300 steps.
+pub fn original_fitness_settings() -> PsaSettings {
+    let mut original = native(PsaSettings::default());
+    original.fitness.kind = FitnessKind::Original;
+    original.steps = 300;
+    original
+}
+
+/// One evaluation stream per network seed.
+pub fn streams(seeds: std::ops::Range<u64>) -> Vec<Stream> {
+    seeds.map(|s| stream(s, &[2])).collect()
+}
+
+/// The fitness of networks `seeds` on the scalar path, the reference.
+pub fn scalar_fitness(settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>) -> Vec<f64> {
+    let mut runner = TrialRunner::new(settings, task).unwrap();
+    seeds
+        .clone()
+        .map(random_network)
+        .zip(streams(seeds))
+        .map(|(n, mut rng)| runner.evaluate(&n, &mut rng).unwrap())
+        .collect()
+}
+
+/// Asserts that `other` holds the bits of `scalar`, naming the networks that differ.
+pub fn assert_bit_identical(scalar: &[f64], other: &[f64], what: &str) {
+    assert_eq!(scalar.len(), other.len());
+    let differing: Vec<usize> = (0..scalar.len())
+        .filter(|&i| scalar[i].to_bits() != other[i].to_bits())
+        .collect();
+    assert!(
+        differing.is_empty(),
+        "{what}: {} of {} networks differ, first {:?}: scalar {} other {}",
+        differing.len(),
+        scalar.len(),
+        differing.first(),
+        scalar[differing[0]],
+        other[differing[0]]
+    );
+}
+
+/// Asserts that the `cuda` trial kernel, its trials flown by `fly` (the
+/// host build or a GPU), gives the scalar path's fitness bit for bit on
+/// 1,700 random networks: 400 per task clean, 200 per task on tasks 1 and
+/// 3 with noise on inputs and outputs, random starts and 3 trials, and 100
+/// with the original fitness.
+pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Result<TrialPoints, PsaError>) {
+    let kernel = |settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>| {
+        let networks: Vec<Network> = seeds.clone().map(random_network).collect();
+        let refs: Vec<&Network> = networks.iter().collect();
+        evaluate_with(settings, task, &refs[..], 0..refs.len(), &mut streams(seeds), &fly).unwrap()
+    };
+    let clean = native(PsaSettings::default());
+    for task in Task::ALL {
+        let seeds = 9000..9400;
+        let what = format!("clean task {task}");
+        assert_bit_identical(
+            &scalar_fitness(&clean, task, seeds.clone()),
+            &kernel(&clean, task, seeds),
+            &what,
+        );
+    }
+    let noisy = noisy_settings();
+    for task in [Task::StopRotation, Task::StopAtPosition] {
+        let seeds = 9500..9700;
+        let what = format!("noisy task {task}");
+        assert_bit_identical(
+            &scalar_fitness(&noisy, task, seeds.clone()),
+            &kernel(&noisy, task, seeds),
+            &what,
+        );
+    }
+    let original = original_fitness_settings();
+    let seeds = 9800..9900;
+    assert_bit_identical(
+        &scalar_fitness(&original, Task::Turn, seeds.clone()),
+        &kernel(&original, Task::Turn, seeds),
+        "original fitness",
+    );
+}
