@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::backend::BackendArg;
 use crate::experiment::{run_evolution, Preset};
 use crate::ode::MAX_THREADS;
-use crate::physics::BackendKind;
 use crate::psa::Task;
 
 /// Arguments of `evolve`.
@@ -28,9 +28,9 @@ pub struct EvolveArgs {
     /// A TOML file overriding any setting of the preset (see README).
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Physics backend, overriding the configuration.
+    /// Physics backend, overriding the configuration (`cuda`: native's physics on the GPU).
     #[arg(long, value_enum)]
-    pub backend: Option<BackendKind>,
+    pub backend: Option<BackendArg>,
     /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
     #[arg(long, alias = "jobs", default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
     pub threads: u64,
@@ -63,9 +63,10 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
         config.set_generations(g)?;
     }
     if let Some(backend) = args.backend {
-        config.problem.backend = backend;
+        config.problem.backend = backend.physics();
     }
     config.validate()?;
+    args.backend.map_or(Ok(()), BackendArg::prepare)?;
     let out = args
         .out
         .clone()

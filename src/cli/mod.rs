@@ -8,6 +8,7 @@ macro_rules! say {
     };
 }
 
+mod backend;
 pub mod bench;
 pub mod bench_ode;
 pub mod bench_runs;

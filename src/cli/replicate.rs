@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 
+use super::backend::BackendArg;
 use super::evolve::progress_bar;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
@@ -51,9 +52,9 @@ pub struct GridArgs {
     /// Generations (ESP) or cycles (hill-climber) per run (at most 1,000,000).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_GENERATIONS as u64))]
     pub generations: Option<u64>,
-    /// Physics backend.
+    /// Physics backend (`cuda`: native's physics on the GPU, the runs in lockstep).
     #[arg(long, value_enum)]
-    pub backend: Option<BackendKind>,
+    pub backend: Option<BackendArg>,
     /// Fly every champion again on ode after its run on native: its fitness
     /// and robustness results must be bit-identical, recorded in run.json
     /// (default: on for --preset paper on native).
@@ -104,11 +105,16 @@ fn parse_duration(text: &str) -> Result<Duration, String> {
 impl GridArgs {
     /// The executor these options ask for.
     pub fn executor(&self) -> Executor {
-        if self.lockstep {
+        if self.lockstep || self.backend == Some(BackendArg::Cuda) {
             Executor::Lockstep
         } else {
             Executor::RunByRun
         }
+    }
+
+    /// Opens the GPU for `--backend cuda` (see [`BackendArg::prepare`]).
+    pub fn prepare_backend(&self) -> Result<()> {
+        self.backend.map_or(Ok(()), BackendArg::prepare)
     }
 
     /// The grid these options describe.
@@ -125,7 +131,7 @@ impl GridArgs {
         }
         spec.seeds = self.seeds.unwrap_or(spec.seeds);
         spec.generations = self.generations.map_or(spec.generations, |g| g as usize);
-        spec.backend = self.backend.unwrap_or(spec.backend);
+        spec.backend = self.backend.map_or(spec.backend, BackendArg::physics);
         spec.robustness_trials = self.robustness_trials.map_or(spec.robustness_trials, |t| t as usize);
         spec.ode_check = match (self.ode_check, self.no_ode_check) {
             (true, _) => true,
@@ -250,6 +256,7 @@ pub fn report_held<'a>(held: impl Iterator<Item = (String, &'a HeldRun)>) {
 /// Runs `replicate`.
 pub fn run(args: ReplicateArgs) -> Result<i32> {
     let spec = args.grid.spec()?;
+    args.grid.prepare_backend()?;
     let progress = Progress::new(args.grid.quiet);
     let options = args.grid.options();
     let summary = replicate(&args.out, &spec, &options, &progress)?;

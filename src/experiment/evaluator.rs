@@ -1,6 +1,7 @@
 //! The PSA control problem as an [`Evaluator`] for the search algorithms.
 
 use std::ops::Range;
+use std::sync::{Arc, OnceLock};
 
 use anyhow::Result;
 
@@ -9,6 +10,7 @@ use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
 use crate::psa::batch::LANES;
+use crate::psa::cuda::{self, CudaTrials};
 use crate::psa::ode_lockstep::ODE_LOCKSTEP;
 use crate::psa::{BatchRunner, OdeLockstepRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use crate::rng::{Stream, StreamFamily};
@@ -19,6 +21,22 @@ use crate::rng::{Stream, StreamFamily};
 /// best level of the CPU, and on `ode` the lockstep path. It changes speed
 /// only: every path gives the same results, bit for bit.
 pub const SIMD_VARIABLE: &str = "PSA_ESP_SIMD";
+
+/// Networks per batch on the GPU: more than any run asks at once, so that
+/// a run's generation goes to the device in one launch.
+pub const CUDA_BATCH: usize = 1 << 20;
+
+/// The GPU every `native` evaluator of the process flies its trials on,
+/// once [`evaluate_on_cuda`] has set it.
+static CUDA: OnceLock<Arc<CudaTrials>> = OnceLock::new();
+
+/// Makes every [`PsaEvaluator`] made from now on with the `native`
+/// backend fly its trials on `gpu` (`--backend cuda`). Like
+/// [`SIMD_VARIABLE`], it changes speed only: the kernel computes the
+/// batched path's results bit for bit. A second call keeps the first GPU.
+pub fn evaluate_on_cuda(gpu: CudaTrials) {
+    let _ = CUDA.set(Arc::new(gpu));
+}
 
 /// Scores a network by its fitness on a task (in % of the theoretical
 /// maximum, the mean over `settings.trials` trials). Each worker thread
@@ -34,6 +52,8 @@ pub struct PsaEvaluator {
     batch: Option<BatchRunner>,
     /// Whether `ode` runs batches in lockstep (each worker its own world).
     ode_lockstep: bool,
+    /// The GPU the trials fly on, where `--backend cuda` set one (`native` only).
+    cuda: Option<Arc<CudaTrials>>,
 }
 
 /// A worker thread's state: its runners, which own the thread's physics
@@ -63,11 +83,13 @@ impl PsaEvaluator {
             _ => None,
         };
         let ode_lockstep = OdeLockstepRunner::supports(&settings);
+        let cuda = CUDA.get().filter(|_| settings.backend == BackendKind::Native).cloned();
         let evaluator = PsaEvaluator {
             settings,
             task,
             batch,
             ode_lockstep,
+            cuda,
         };
         Ok(match std::env::var(SIMD_VARIABLE) {
             Err(_) => evaluator,
@@ -128,7 +150,9 @@ impl Evaluator for PsaEvaluator {
         Ok(self.scalar(worker)?.evaluate(network, rng)?)
     }
     fn batch_size(&self) -> usize {
-        if self.batch.is_some() {
+        if self.cuda.is_some() {
+            CUDA_BATCH
+        } else if self.batch.is_some() {
             LANES
         } else if self.ode_lockstep {
             ODE_LOCKSTEP
@@ -137,6 +161,10 @@ impl Evaluator for PsaEvaluator {
         }
     }
     fn narrowest_batch(&self) -> usize {
+        if self.cuda.is_some() {
+            // A generation goes to the device whole, not cut between the threads.
+            return CUDA_BATCH;
+        }
         self.batch.as_ref().map_or(1, BatchRunner::narrowest_block)
     }
     fn evaluate_batch<S: NetworkSet + ?Sized>(
@@ -147,6 +175,17 @@ impl Evaluator for PsaEvaluator {
         streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
         let rngs = || -> Vec<Stream> { range.clone().map(|j| streams.stream(j)).collect() };
+        if let Some(gpu) = &self.cuda {
+            let (settings, task) = (&self.settings, self.task);
+            return Ok(cuda::evaluate_with(
+                settings,
+                task,
+                networks,
+                range.clone(),
+                &mut rngs(),
+                |batch| gpu.fly(batch),
+            )?);
+        }
         if let Some(batch) = &self.batch {
             return Ok(batch.evaluate(networks, range.clone(), &mut rngs())?);
         }

@@ -16,6 +16,10 @@
 //! ended non-finite on the scalar path, which names the error, as the
 //! batched path does.
 
+mod device;
+
+pub use device::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME, KERNEL_SOURCE, THREADS_PER_BLOCK};
+
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{FitnessKind, SlowingRule, Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::network::NetworkSet;

@@ -327,11 +327,11 @@ PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial 
 }
 
 #ifdef __CUDACC_RTC__
-/* One thread per trial. */
-extern "C" __global__ void psa_trials(PsaParams params, const double *weights, const PsaTrial *trials, int count,
-                                      double *points, int *finite) {
+/* One thread per trial; the settings, the weights and the trials lie in device memory. */
+extern "C" __global__ void psa_trials(const PsaParams *params, const double *weights, const PsaTrial *trials,
+                                      int count, double *points, int *finite) {
     int i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i < count) points[i] = psa_fly(&params, weights, &trials[i], &finite[i]);
+    if (i < count) points[i] = psa_fly(params, weights, &trials[i], &finite[i]);
 }
 #else
 /* The same trials flown one after another on the host. */

@@ -1,0 +1,133 @@
+//! The `cuda` path on real CUDA libraries. Each test runs where what it
+//! needs is there and is reported as ignored, by name, where not (this
+//! harness decides at run time, and prints why on standard error):
+//!
+//! - `nvrtc_compiles_the_trial_kernel`: a `cuda` build and NVRTC (no GPU);
+//! - `the_gpu_gives_the_scalar_paths_bits`: a `cuda` build, the driver,
+//!   NVRTC and a device; the kernel's fitness on the GPU against the scalar
+//!   path, bit for bit, on the 1,700 networks of the host build's test;
+//! - `the_gpu_grid_is_byte_identical_to_native`: the same, and a tiny grid
+//!   with `--backend cuda` against one with `--backend native`, file for file;
+//! - `the_cuda_backend_fails_cleanly_without_a_gpu`: where there is no GPU
+//!   (or driver, NVRTC or `cuda` build), `--backend cuda` exits 2 naming
+//!   what is missing.
+
+mod common;
+mod kernel_cases;
+
+use libtest_mimic::{Arguments, Failed, Trial};
+
+/// Set (as CI does), the NVRTC test runs, and fails, where NVRTC is missing
+/// instead of being ignored.
+const REQUIRE_NVRTC: &str = "PSA_ESP_REQUIRE_NVRTC";
+use psa_esp::psa::cuda::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME};
+
+fn nvrtc_compiles_the_trial_kernel() -> Result<(), Failed> {
+    let ptx = compile_for_check().map_err(|e| e.to_string())?;
+    if !ptx.contains(&format!(".entry {KERNEL_NAME}")) {
+        return Err(format!("the PTX has no entry {KERNEL_NAME}").into());
+    }
+    // The kernel's explicit fma() calls, in double precision.
+    if !ptx.contains("fma.rn.f64") {
+        return Err("the PTX has no double-precision fma".into());
+    }
+    Ok(())
+}
+
+fn the_gpu_gives_the_scalar_paths_bits() -> Result<(), Failed> {
+    let gpu = CudaTrials::open().map_err(|e| e.to_string())?;
+    eprintln!("on {}", gpu.device());
+    kernel_cases::assert_kernel_gives_the_scalar_paths_bits(|batch| gpu.fly(batch));
+    Ok(())
+}
+
+/// A small grid with noise and random starts: `replicate` on `backend`.
+fn small_grid(backend: &str, out: &std::path::Path) -> std::process::Output {
+    let out = out.to_str().unwrap();
+    common::psa_esp(&[
+        "replicate",
+        "--preset",
+        "quick",
+        "--configs",
+        "baseline,input-noise,random-init",
+        "--tasks",
+        "1,2,3",
+        "--seeds",
+        "2",
+        "--generations",
+        "5",
+        "--robustness-trials",
+        "5",
+        "--backend",
+        backend,
+        "--quiet",
+        "--out",
+        out,
+    ])
+}
+
+fn the_gpu_grid_is_byte_identical_to_native() -> Result<(), Failed> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let (native, cuda) = (dir.path().join("native"), dir.path().join("cuda"));
+    for (backend, out) in [("native", &native), ("cuda", &cuda)] {
+        let output = small_grid(backend, out);
+        if !output.status.success() {
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            return Err(format!("replicate --backend {backend}: {stderr}").into());
+        }
+    }
+    common::assert_same_runs(&native, &cuda);
+    Ok(())
+}
+
+/// Without a GPU (or NVRTC, or a `cuda` build), `--backend cuda` exits 2
+/// with the missing piece named, before writing anything.
+fn the_cuda_backend_fails_cleanly_without_a_gpu(why: String) -> Result<(), Failed> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let out = dir.path().join("grid");
+    let output = small_grid("cuda", &out);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if output.status.code() != Some(2) || !stderr.contains(&why) || stderr.contains("panicked") {
+        return Err(format!(
+            "expected exit 2 naming {why:?}, got {:?}: {stderr}",
+            output.status.code()
+        )
+        .into());
+    }
+    if out.exists() {
+        return Err("the failed grid wrote its folder".into());
+    }
+    Ok(())
+}
+
+fn main() {
+    let args = Arguments::from_args();
+    let nvrtc = compile_for_check().err();
+    let gpu = CudaTrials::open().err();
+    for (what, missing) in [("NVRTC", &nvrtc), ("a GPU", &gpu)] {
+        if let Some(why) = missing {
+            eprintln!("gpu tests: the tests that need {what} are ignored: {why}");
+        }
+    }
+    let needs = |missing: &Option<CudaUnavailable>| missing.is_some();
+    let gpu_missing = gpu.as_ref().map(ToString::to_string);
+    let tests = vec![
+        Trial::test("nvrtc_compiles_the_trial_kernel", nvrtc_compiles_the_trial_kernel)
+            .with_ignored_flag(needs(&nvrtc) && std::env::var_os(REQUIRE_NVRTC).is_none()),
+        Trial::test(
+            "the_gpu_gives_the_scalar_paths_bits",
+            the_gpu_gives_the_scalar_paths_bits,
+        )
+        .with_ignored_flag(needs(&gpu)),
+        Trial::test(
+            "the_gpu_grid_is_byte_identical_to_native",
+            the_gpu_grid_is_byte_identical_to_native,
+        )
+        .with_ignored_flag(needs(&gpu)),
+        Trial::test("the_cuda_backend_fails_cleanly_without_a_gpu", move || {
+            the_cuda_backend_fails_cleanly_without_a_gpu(gpu_missing.clone().unwrap_or_default())
+        })
+        .with_ignored_flag(!needs(&gpu)),
+    ];
+    libtest_mimic::run(&args, tests).exit();
+}
