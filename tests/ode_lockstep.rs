@@ -3,6 +3,9 @@
 //! fitness, bit for bit, on every task, with noise, random starts, several
 //! trials, both steppers, the Plane2D joint and the gyroscopic term.
 
+mod kernel_cases;
+
+use kernel_cases::{random_network, streams};
 use psa_esp::network::Network;
 use psa_esp::physics::{
     random_thrust_sequence, BodyState, OdeBackend, OdeFleet, PhysicsBackend, PlanarState, PlaneConstraint,
@@ -10,26 +13,6 @@ use psa_esp::physics::{
 };
 use psa_esp::psa::ode_lockstep::ODE_LOCKSTEP;
 use psa_esp::psa::{BodySettings, NoiseSettings, OdeLockstepRunner, PsaSettings, Task, TrialRunner};
-use psa_esp::rng::{stream, Stream};
-use rand::RngExt;
-
-/// A random 7-H-4 network (H in 1..=9, weights of scale 0.3 to 30, now and
-/// then a lesioned neuron), as `tests/batch.rs` makes them.
-fn random_network(seed: u64) -> Network {
-    let mut rng = stream(seed, &[1]);
-    let hidden = rng.random_range(1..=9);
-    let scale = [0.3, 1.0, 3.0, 6.0, 30.0][rng.random_range(0..5)];
-    let genes = (0..hidden * 11).map(|_| rng.random_range(-scale..scale)).collect();
-    let mut network = Network::from_genes(7, 4, genes).unwrap();
-    if hidden > 1 && rng.random_bool(0.2) {
-        network.set_lesioned(rng.random_range(0..hidden), true);
-    }
-    network
-}
-
-fn streams(seeds: std::ops::Range<u64>) -> Vec<Stream> {
-    seeds.map(|s| stream(s, &[2])).collect()
-}
 
 fn bits(values: &[f64]) -> Vec<u64> {
     values.iter().map(|v| v.to_bits()).collect()
