@@ -2,6 +2,8 @@
 //! needs is there and is reported as ignored, by name, where not (this
 //! harness decides at run time, and prints why on standard error):
 //!
+//! - `the_kernel_path_on_the_host_gives_the_native_grid` (always): the
+//!   GPU path's plumbing, with the kernel built for the host;
 //! - `nvrtc_compiles_the_trial_kernel`: a `cuda` build and NVRTC (no GPU);
 //! - `the_gpu_gives_the_scalar_paths_bits`: a `cuda` build, the driver,
 //!   NVRTC and a device; the kernel's fitness on the GPU against the scalar
@@ -20,6 +22,7 @@ use libtest_mimic::{Arguments, Failed, Trial};
 /// Set (as CI does), the NVRTC test runs, and fails, where NVRTC is missing
 /// instead of being ignored.
 const REQUIRE_NVRTC: &str = "PSA_ESP_REQUIRE_NVRTC";
+use psa_esp::experiment::{KERNEL_ON_HOST, SIMD_VARIABLE};
 use psa_esp::psa::cuda::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME};
 
 fn nvrtc_compiles_the_trial_kernel() -> Result<(), Failed> {
@@ -43,8 +46,17 @@ fn the_gpu_gives_the_scalar_paths_bits() -> Result<(), Failed> {
 
 /// A small grid with noise and random starts: `replicate` on `backend`.
 fn small_grid(backend: &str, out: &std::path::Path) -> std::process::Output {
+    small_grid_with(backend, out, None)
+}
+
+/// [`small_grid`] with `PSA_ESP_SIMD` set to `path`, if given.
+fn small_grid_with(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::process::Output {
     let out = out.to_str().unwrap();
-    common::psa_esp(&[
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_psa-esp"));
+    if let Some(path) = path {
+        command.env(SIMD_VARIABLE, path);
+    }
+    command.args([
         "replicate",
         "--preset",
         "quick",
@@ -61,9 +73,28 @@ fn small_grid(backend: &str, out: &std::path::Path) -> std::process::Output {
         "--backend",
         backend,
         "--quiet",
+        "--lockstep",
         "--out",
         out,
-    ])
+    ]);
+    command.output().unwrap()
+}
+
+/// The GPU path's plumbing without a GPU: the small grid in lockstep with
+/// every trial flown by the kernel built for the host (`PSA_ESP_SIMD=kernel-host`,
+/// a generation per call, as a GPU gets them) against `native`, file for file.
+fn the_kernel_path_on_the_host_gives_the_native_grid() -> Result<(), Failed> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let (native, kernel) = (dir.path().join("native"), dir.path().join("kernel"));
+    for (path, out) in [(None, &native), (Some(KERNEL_ON_HOST), &kernel)] {
+        let output = small_grid_with("native", out, path);
+        if !output.status.success() {
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            return Err(format!("replicate with {path:?}: {stderr}").into());
+        }
+    }
+    common::assert_same_runs(&native, &kernel);
+    Ok(())
 }
 
 fn the_gpu_grid_is_byte_identical_to_native() -> Result<(), Failed> {
@@ -112,6 +143,10 @@ fn main() {
     let needs = |missing: &Option<CudaUnavailable>| missing.is_some();
     let gpu_missing = gpu.as_ref().map(ToString::to_string);
     let tests = vec![
+        Trial::test(
+            "the_kernel_path_on_the_host_gives_the_native_grid",
+            the_kernel_path_on_the_host_gives_the_native_grid,
+        ),
         Trial::test("nvrtc_compiles_the_trial_kernel", nvrtc_compiles_the_trial_kernel)
             .with_ignored_flag(needs(&nvrtc) && std::env::var_os(REQUIRE_NVRTC).is_none()),
         Trial::test(

@@ -2,8 +2,9 @@
 //! the `native` backend's physics with every trial flown on the GPU.
 
 use anyhow::Result;
+use std::sync::Arc;
 
-use crate::experiment::evaluate_on_cuda;
+use crate::experiment::fly_trials_on;
 use crate::physics::BackendKind;
 use crate::psa::cuda::CudaTrials;
 
@@ -40,7 +41,7 @@ impl BackendArg {
         if self == BackendArg::Cuda {
             let gpu = CudaTrials::open().map_err(|e| anyhow::anyhow!("--backend cuda: {e}"))?;
             eprintln!("evaluating on {}", gpu.device());
-            evaluate_on_cuda(gpu);
+            fly_trials_on(Arc::new(gpu));
         }
         Ok(())
     }

@@ -10,32 +10,37 @@ use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
 use crate::psa::batch::LANES;
-use crate::psa::cuda::{self, CudaTrials};
+use crate::psa::cuda::{self, HostTrials, TrialFlier};
 use crate::psa::ode_lockstep::ODE_LOCKSTEP;
 use crate::psa::{BatchRunner, OdeLockstepRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use crate::rng::{Stream, StreamFamily};
 
 /// The environment variable that picks the evaluation path: `scalar` (one
-/// network at a time, on `ode` one world per network), or a SIMD level
-/// (`portable`, `avx2`, `avx512`) for `native`'s batched path; unset, the
+/// network at a time, on `ode` one world per network), a SIMD level
+/// (`portable`, `avx2`, `avx512`) for `native`'s batched path, or
+/// `kernel-host` for `native` flown by the cuda path's kernel built for
+/// the host (the GPU path's plumbing without a GPU, slowly); unset, the
 /// best level of the CPU, and on `ode` the lockstep path. It changes speed
 /// only: every path gives the same results, bit for bit.
 pub const SIMD_VARIABLE: &str = "PSA_ESP_SIMD";
 
-/// Networks per batch on the GPU: more than any run asks at once, so that
-/// a run's generation goes to the device in one launch.
+/// The [`SIMD_VARIABLE`] value for the cuda kernel built for the host.
+pub const KERNEL_ON_HOST: &str = "kernel-host";
+
+/// Networks per batch on the cuda kernel: more than any run asks at once,
+/// so that a run's generation goes to the device in one launch.
 pub const CUDA_BATCH: usize = 1 << 20;
 
-/// The GPU every `native` evaluator of the process flies its trials on,
-/// once [`evaluate_on_cuda`] has set it.
-static CUDA: OnceLock<Arc<CudaTrials>> = OnceLock::new();
+/// What every `native` evaluator of the process flies its trials on, once
+/// [`fly_trials_on`] has set it.
+static FLIER: OnceLock<Arc<dyn TrialFlier>> = OnceLock::new();
 
 /// Makes every [`PsaEvaluator`] made from now on with the `native`
-/// backend fly its trials on `gpu` (`--backend cuda`). Like
+/// backend fly its trials on `flier` (`--backend cuda`: the GPU). Like
 /// [`SIMD_VARIABLE`], it changes speed only: the kernel computes the
-/// batched path's results bit for bit. A second call keeps the first GPU.
-pub fn evaluate_on_cuda(gpu: CudaTrials) {
-    let _ = CUDA.set(Arc::new(gpu));
+/// batched path's results bit for bit. A second call keeps the first.
+pub fn fly_trials_on(flier: Arc<dyn TrialFlier>) {
+    let _ = FLIER.set(flier);
 }
 
 /// Scores a network by its fitness on a task (in % of the theoretical
@@ -52,8 +57,8 @@ pub struct PsaEvaluator {
     batch: Option<BatchRunner>,
     /// Whether `ode` runs batches in lockstep (each worker its own world).
     ode_lockstep: bool,
-    /// The GPU the trials fly on, where `--backend cuda` set one (`native` only).
-    cuda: Option<Arc<CudaTrials>>,
+    /// The cuda kernel's flier (a GPU, or the host build), where one is set (`native` only).
+    kernel: Option<Arc<dyn TrialFlier>>,
 }
 
 /// A worker thread's state: its runners, which own the thread's physics
@@ -83,17 +88,24 @@ impl PsaEvaluator {
             _ => None,
         };
         let ode_lockstep = OdeLockstepRunner::supports(&settings);
-        let cuda = CUDA.get().filter(|_| settings.backend == BackendKind::Native).cloned();
+        let native = settings.backend == BackendKind::Native;
+        let on_host = std::env::var(SIMD_VARIABLE).is_ok_and(|v| v == KERNEL_ON_HOST);
+        let kernel = match FLIER.get() {
+            Some(flier) if native => Some(flier.clone()),
+            _ if native && on_host => Some(Arc::new(HostTrials) as Arc<dyn TrialFlier>),
+            _ => None,
+        };
         let evaluator = PsaEvaluator {
             settings,
             task,
             batch,
             ode_lockstep,
-            cuda,
+            kernel,
         };
         Ok(match std::env::var(SIMD_VARIABLE) {
             Err(_) => evaluator,
             Ok(choice) if choice == "scalar" => evaluator.with_batching(None).with_ode_lockstep(false),
+            Ok(choice) if choice == KERNEL_ON_HOST => evaluator,
             Ok(choice) => {
                 evaluator.with_batching(Some(choice.parse().map_err(|e| {
                     anyhow::anyhow!("{SIMD_VARIABLE}={choice:?}: {e} (or scalar for the scalar path)")
@@ -150,7 +162,7 @@ impl Evaluator for PsaEvaluator {
         Ok(self.scalar(worker)?.evaluate(network, rng)?)
     }
     fn batch_size(&self) -> usize {
-        if self.cuda.is_some() {
+        if self.kernel.is_some() {
             CUDA_BATCH
         } else if self.batch.is_some() {
             LANES
@@ -161,7 +173,7 @@ impl Evaluator for PsaEvaluator {
         }
     }
     fn narrowest_batch(&self) -> usize {
-        if self.cuda.is_some() {
+        if self.kernel.is_some() {
             // A generation goes to the device whole, not cut between the threads.
             return CUDA_BATCH;
         }
@@ -175,7 +187,7 @@ impl Evaluator for PsaEvaluator {
         streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
         let rngs = || -> Vec<Stream> { range.clone().map(|j| streams.stream(j)).collect() };
-        if let Some(gpu) = &self.cuda {
+        if let Some(flier) = &self.kernel {
             let (settings, task) = (&self.settings, self.task);
             return Ok(cuda::evaluate_with(
                 settings,
@@ -183,7 +195,7 @@ impl Evaluator for PsaEvaluator {
                 networks,
                 range.clone(),
                 &mut rngs(),
-                |batch| gpu.fly(batch),
+                |batch| flier.fly(batch),
             )?);
         }
         if let Some(batch) = &self.batch {

@@ -17,6 +17,6 @@ pub mod stats;
 pub mod sweep;
 
 pub use config::{paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};
-pub use evaluator::{evaluate_on_cuda, PsaEvaluator, PsaWorker, CUDA_BATCH, SIMD_VARIABLE};
+pub use evaluator::{fly_trials_on, PsaEvaluator, PsaWorker, CUDA_BATCH, KERNEL_ON_HOST, SIMD_VARIABLE};
 pub use report::{write_report, ReportFormat, ReportOutcome};
 pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles, RunStart};

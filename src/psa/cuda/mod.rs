@@ -233,6 +233,39 @@ pub fn evaluate_with<S: NetworkSet + ?Sized>(
     Ok(fitness)
 }
 
+/// Flies a [`TrialBatch`] as `trial.cu` says: a GPU ([`CudaTrials`]) or
+/// the kernel built for the host ([`HostTrials`]).
+pub trait TrialFlier: Send + Sync + std::fmt::Debug {
+    /// Each trial's points and whether it ended finite.
+    fn fly(&self, batch: &TrialBatch) -> Result<TrialPoints, PsaError>;
+    /// What flies them, for the user.
+    fn describe(&self) -> String;
+}
+
+/// The kernel built for the host ([`fly_on_host`]) as a [`TrialFlier`]:
+/// the GPU path's plumbing, exactly, on any machine (slowly: one trial
+/// after another).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct HostTrials;
+
+impl TrialFlier for HostTrials {
+    fn fly(&self, batch: &TrialBatch) -> Result<TrialPoints, PsaError> {
+        fly_on_host(batch)
+    }
+    fn describe(&self) -> String {
+        "the cuda kernel built for the host (psa-trial-host)".into()
+    }
+}
+
+impl TrialFlier for CudaTrials {
+    fn fly(&self, batch: &TrialBatch) -> Result<TrialPoints, PsaError> {
+        CudaTrials::fly(self, batch)
+    }
+    fn describe(&self) -> String {
+        self.device().to_string()
+    }
+}
+
 /// Flies `batch` with the kernel's code compiled for the host
 /// (`psa-trial-host`, built by `build.rs`), one trial after another: the
 /// GPU's arithmetic on the CPU, for checking the kernel without a GPU.
