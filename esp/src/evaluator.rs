@@ -58,6 +58,41 @@ pub trait Evaluator: Sync {
     ) -> Result<Vec<f64>> {
         evaluate_each(self, worker, networks, range, streams)
     }
+
+    /// Whether [`crate::lockstep`] should hand this evaluator all of a
+    /// round's networks that it scores in one call of
+    /// [`Evaluator::evaluate_parts`] (an evaluator that pays per call, such
+    /// as a GPU launch), instead of cutting each run's networks into
+    /// batches for the threads. False by default.
+    fn takes_parts_together(&self) -> bool {
+        false
+    }
+
+    /// The fitness of several sets of networks in one call: part `p` gets
+    /// what [`Evaluator::evaluate_batch`] gives `parts[p]` alone, bit for
+    /// bit, or its own error. The default evaluates the parts one after
+    /// another.
+    fn evaluate_parts<S: NetworkSet + ?Sized>(
+        &self,
+        worker: &mut Self::Worker,
+        parts: &[Part<'_, S>],
+    ) -> Vec<Result<Vec<f64>>> {
+        parts
+            .iter()
+            .map(|part| self.evaluate_batch(worker, part.networks, part.range.clone(), part.streams))
+            .collect()
+    }
+}
+
+/// Networks `range` of `networks`, network `j` with `streams.stream(j)`:
+/// one part of an [`Evaluator::evaluate_parts`] call.
+pub struct Part<'a, S: ?Sized> {
+    /// The networks.
+    pub networks: &'a S,
+    /// Which of them.
+    pub range: Range<usize>,
+    /// Their streams.
+    pub streams: &'a StreamFamily,
 }
 
 /// [`Evaluator::evaluate_batch`] network by network, through

@@ -13,7 +13,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use crate::ask::AskTell;
-use crate::evaluator::{batch_ranges, check_fitness};
+use crate::evaluator::{batch_ranges, check_fitness, Part};
 use crate::network::NetworkSet;
 use crate::rng::StreamFamily;
 use crate::{Control, Evaluator, GenerationRecord, RunError};
@@ -50,10 +50,24 @@ pub fn evaluate_jobs<E: Evaluator, S: NetworkSet + ?Sized>(jobs: &[Job<'_, E, S>
             },
         )
         .collect();
+    // An evaluator that takes its parts together gets all its jobs in one call.
+    let together: Vec<usize> = (0..distinct.len())
+        .filter(|&id| distinct[id].takes_parts_together())
+        .collect();
+    let groups: Vec<Vec<usize>> = together
+        .iter()
+        .map(|&id| (0..jobs.len()).filter(|&i| ids[i] == id).collect())
+        .collect();
+    let grouped: Vec<(usize, Result<Vec<f64>, RunError>)> = groups
+        .par_iter()
+        .with_max_len(1)
+        .flat_map_iter(|group| evaluate_group(jobs, group))
+        .collect();
     let threads = rayon::current_num_threads();
     let pieces: Vec<(usize, Range<usize>)> = jobs
         .iter()
         .enumerate()
+        .filter(|&(i, _)| !together.contains(&ids[i]))
         .flat_map(|(i, job)| {
             let (e, len) = (job.evaluator, job.networks.len());
             let ranges = if e.batch_size() > 1 {
@@ -84,7 +98,7 @@ pub fn evaluate_jobs<E: Evaluator, S: NetworkSet + ?Sized>(jobs: &[Job<'_, E, S>
         .iter()
         .map(|job| Ok(Vec::with_capacity(job.networks.len())))
         .collect();
-    for (i, piece) in results {
+    for (i, piece) in grouped.into_iter().chain(results) {
         if let Ok(done) = &mut fitness[i] {
             match piece {
                 Ok(values) => done.extend(values),
@@ -93,6 +107,46 @@ pub fn evaluate_jobs<E: Evaluator, S: NetworkSet + ?Sized>(jobs: &[Job<'_, E, S>
         }
     }
     fitness
+}
+
+/// Jobs `group` of `jobs`, which share an evaluator that takes its parts
+/// together, in one [`Evaluator::evaluate_parts`] call: each job's fitness
+/// or error.
+fn evaluate_group<E: Evaluator, S: NetworkSet + ?Sized>(
+    jobs: &[Job<'_, E, S>],
+    group: &[usize],
+) -> Vec<(usize, Result<Vec<f64>, RunError>)> {
+    let evaluator = jobs[group[0]].evaluator;
+    let mut worker = match evaluator.worker() {
+        Ok(worker) => worker,
+        Err(e) => {
+            let message = format!("{e:#}");
+            return group
+                .iter()
+                .map(|&i| (i, Err(RunError::Worker(anyhow::anyhow!("{message}")))))
+                .collect();
+        }
+    };
+    let parts: Vec<Part<'_, S>> = group
+        .iter()
+        .map(|&i| Part {
+            networks: jobs[i].networks,
+            range: 0..jobs[i].networks.len(),
+            streams: &jobs[i].streams,
+        })
+        .collect();
+    let results = evaluator.evaluate_parts(&mut worker, &parts);
+    assert_eq!(results.len(), group.len(), "one result per part");
+    group
+        .iter()
+        .zip(results)
+        .map(|(&i, result)| {
+            let checked = result
+                .map_err(RunError::from)
+                .and_then(|fitness| check_fitness(&fitness, 0).map(|()| fitness));
+            (i, checked)
+        })
+        .collect()
 }
 
 /// Networks `range` of `job`, with the worker in `slot` (made if absent).

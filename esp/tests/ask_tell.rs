@@ -6,7 +6,7 @@ use esp_neuroevolution::network::{Network, NetworkSet};
 use esp_neuroevolution::rng::Stream;
 use esp_neuroevolution::{
     evaluate_all, AskPurpose, AskTell, Control, Ending, Esp, EspSettings, Evaluator, FnEvaluator, GenerationRecord,
-    HillClimb, HillClimbSettings, RunError, RunResult, StopAt, TopologyMode,
+    HillClimb, HillClimbSettings, Part, RunError, RunResult, StopAt, TopologyMode,
 };
 use rand::RngExt;
 
@@ -349,4 +349,75 @@ fn jobs_evaluated_together_get_what_each_gets_alone() {
         let alone = evaluate_all(&evaluator, &networks[i..], *seed, key).unwrap();
         assert_eq!(together[i].as_ref().unwrap(), &alone);
     }
+}
+
+/// `inner` as an evaluator that takes a round's parts together (as a GPU
+/// does), noting how many parts each call gets.
+struct Together<E> {
+    inner: E,
+    calls: std::sync::Mutex<Vec<usize>>,
+}
+
+impl<E: Evaluator> Evaluator for Together<E> {
+    type Worker = E::Worker;
+    fn inputs(&self) -> usize {
+        self.inner.inputs()
+    }
+    fn outputs(&self) -> usize {
+        self.inner.outputs()
+    }
+    fn worker(&self) -> anyhow::Result<E::Worker> {
+        self.inner.worker()
+    }
+    fn evaluate(&self, worker: &mut E::Worker, network: &Network, rng: &mut Stream) -> anyhow::Result<f64> {
+        self.inner.evaluate(worker, network, rng)
+    }
+    fn takes_parts_together(&self) -> bool {
+        true
+    }
+    fn evaluate_parts<S: NetworkSet + ?Sized>(
+        &self,
+        worker: &mut E::Worker,
+        parts: &[Part<'_, S>],
+    ) -> Vec<anyhow::Result<Vec<f64>>> {
+        self.calls.lock().unwrap().push(parts.len());
+        parts
+            .iter()
+            .map(|p| {
+                self.inner
+                    .evaluate_batch(worker, p.networks, p.range.clone(), p.streams)
+            })
+            .collect()
+    }
+}
+
+#[test]
+fn an_evaluator_that_takes_parts_together_gets_every_run_of_a_round_in_one_call() {
+    let together = Together {
+        inner: problem(),
+        calls: std::sync::Mutex::new(Vec::new()),
+    };
+    let esps: Vec<Esp> = (0..4)
+        .map(|seed| Esp::new(small(EspSettings::hoverstad()), seed).unwrap())
+        .collect();
+    let expected: Vec<RunResult> = esps.iter().map(|e| e.run(&problem(), |_| {}).unwrap()).collect();
+    let mut runs: Vec<Box<dyn AskTell + Send>> = esps
+        .iter()
+        .map(|e| Box::new(e.start(2, 1).unwrap()) as Box<dyn AskTell + Send>)
+        .collect();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let errors = pool.install(|| lockstep(&mut runs, &[&together; 4], |_, _| Control::Continue));
+    assert!(errors.iter().all(Option::is_none), "{errors:?}");
+    for (run, expected) in runs.iter().zip(&expected) {
+        assert_eq!(bits(&run.result().unwrap()), bits(expected));
+    }
+    let calls = together.calls.into_inner().unwrap();
+    // A call a round, each with every run still going: all 4 at first.
+    assert_eq!(calls[0], 4, "{calls:?}");
+    assert!(calls.iter().all(|&parts| (1..=4).contains(&parts)), "{calls:?}");
+    let rounds = expected.iter().map(|r| r.records.len()).max().unwrap();
+    assert!(
+        calls.len() >= rounds && calls.len() < calls.iter().sum::<usize>(),
+        "{calls:?}"
+    );
 }

@@ -5,12 +5,12 @@ use std::sync::{Arc, OnceLock};
 
 use anyhow::Result;
 
-use crate::evolution::{evaluate_each, Evaluator};
+use crate::evolution::{evaluate_each, Evaluator, Part};
 use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
 use crate::psa::batch::LANES;
-use crate::psa::cuda::{self, HostTrials, TrialFlier};
+use crate::psa::cuda::{self, HostTrials, KernelPart, TrialFlier};
 use crate::psa::ode_lockstep::ODE_LOCKSTEP;
 use crate::psa::{BatchRunner, OdeLockstepRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use crate::rng::{Stream, StreamFamily};
@@ -178,6 +178,42 @@ impl Evaluator for PsaEvaluator {
             return CUDA_BATCH;
         }
         self.batch.as_ref().map_or(1, BatchRunner::narrowest_block)
+    }
+    fn takes_parts_together(&self) -> bool {
+        self.kernel.is_some()
+    }
+    fn evaluate_parts<S: NetworkSet + ?Sized>(
+        &self,
+        worker: &mut PsaWorker,
+        parts: &[Part<'_, S>],
+    ) -> Vec<Result<Vec<f64>>> {
+        let Some(flier) = &self.kernel else {
+            return parts
+                .iter()
+                .map(|part| self.evaluate_batch(worker, part.networks, part.range.clone(), part.streams))
+                .collect();
+        };
+        // Every part's trials in one flight of the kernel: one GPU launch.
+        let mut rngs: Vec<Vec<Stream>> = parts
+            .iter()
+            .map(|part| part.range.clone().map(|j| part.streams.stream(j)).collect())
+            .collect();
+        let mut kernel_parts: Vec<KernelPart<'_, S>> = parts
+            .iter()
+            .zip(&mut rngs)
+            .map(|(part, rngs)| KernelPart {
+                networks: part.networks,
+                range: part.range.clone(),
+                rngs,
+            })
+            .collect();
+        match cuda::evaluate_parts_with(&self.settings, self.task, &mut kernel_parts, |batch| flier.fly(batch)) {
+            Ok(results) => results.into_iter().map(|r| Ok(r?)).collect(),
+            Err(e) => {
+                let message = e.to_string();
+                parts.iter().map(|_| Err(anyhow::anyhow!("{message}"))).collect()
+            }
+        }
     }
     fn evaluate_batch<S: NetworkSet + ?Sized>(
         &self,

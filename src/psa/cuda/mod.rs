@@ -205,6 +205,36 @@ pub fn evaluate_with<S: NetworkSet + ?Sized>(
     rngs: &mut [Stream],
     fly: impl FnOnce(&TrialBatch) -> Result<TrialPoints, PsaError>,
 ) -> Result<Vec<f64>, PsaError> {
+    let mut parts = [KernelPart { networks, range, rngs }];
+    evaluate_parts_with(settings, task, &mut parts, fly)?
+        .pop()
+        .expect("one part")
+}
+
+/// Networks `range` of `networks`, network `range.start + i` with stream
+/// `rngs[i]`: one part of [`evaluate_parts_with`].
+pub struct KernelPart<'a, S: ?Sized> {
+    /// The networks.
+    pub networks: &'a S,
+    /// Which of them.
+    pub range: std::ops::Range<usize>,
+    /// Their streams.
+    pub rngs: &'a mut [Stream],
+}
+
+/// [`evaluate_with`] for several parts in one flight of `fly` (one GPU
+/// launch): each part's fitness, or its own error (a part's network whose
+/// flight ended non-finite fails that part only); an error of the settings
+/// or of the flight fails them all.
+///
+/// # Panics
+/// If a part's range and streams differ in length.
+pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
+    settings: &PsaSettings,
+    task: Task,
+    parts: &mut [KernelPart<'_, S>],
+    fly: impl FnOnce(&TrialBatch) -> Result<TrialPoints, PsaError>,
+) -> Result<Vec<Result<Vec<f64>, PsaError>>, PsaError> {
     settings.validate_for(task)?;
     if settings.backend != BackendKind::Native {
         return Err(PsaError::Setting(format!(
@@ -213,24 +243,57 @@ pub fn evaluate_with<S: NetworkSet + ?Sized>(
         )));
     }
     let body = PlanarBody::new(&settings.body.model()?, &settings.physics)?;
-    let positions: Vec<u128> = rngs.iter().map(|r| r.get_word_pos()).collect();
-    let batch = prepare(settings, &body, task, networks, range.clone(), rngs)?;
+    let positions: Vec<Vec<u128>> = parts
+        .iter()
+        .map(|p| p.rngs.iter().map(|r| r.get_word_pos()).collect())
+        .collect();
+    let mut batch = TrialBatch {
+        params: KernelParams::new(settings, &body)?,
+        weights: Vec::new(),
+        trials: Vec::new(),
+    };
+    for part in parts.iter_mut() {
+        let mut one = prepare(settings, &body, task, part.networks, part.range.clone(), part.rngs)?;
+        let shift = i32::try_from(batch.weights.len())
+            .map_err(|_| PsaError::Setting("the cuda kernel's batch is too large (weights)".into()))?;
+        for trial in &mut one.trials {
+            trial.weights = trial
+                .weights
+                .checked_add(shift)
+                .ok_or_else(|| PsaError::Setting("the cuda kernel's batch is too large (weights)".into()))?;
+        }
+        batch.weights.append(&mut one.weights);
+        batch.trials.append(&mut one.trials);
+    }
     let flown = fly(&batch)?;
     let maximum = settings.fitness.maximum(settings.steps);
     let per = settings.trials;
-    let mut fitness = Vec::with_capacity(range.len());
-    for (i, j) in range.enumerate() {
-        let trials = i * per..(i + 1) * per;
-        if flown.finite[trials.clone()].iter().all(|&f| f != 0) {
-            let scores: Vec<f64> = flown.points[trials].iter().map(|p| 100.0 * p / maximum).collect();
-            fitness.push(mean_of_trials(&scores));
-        } else {
-            rngs[i].set_word_pos(positions[i]);
-            let network = networks.network(j);
-            fitness.push(TrialRunner::new(settings, task)?.evaluate(&network, &mut rngs[i])?);
+    let mut first = 0;
+    let mut results = Vec::with_capacity(parts.len());
+    for (part, positions) in parts.iter_mut().zip(positions) {
+        let mut fitness = Vec::with_capacity(part.range.len());
+        let mut failed = None;
+        for (i, j) in part.range.clone().enumerate() {
+            let trials = first + i * per..first + (i + 1) * per;
+            if flown.finite[trials.clone()].iter().all(|&f| f != 0) {
+                let scores: Vec<f64> = flown.points[trials].iter().map(|p| 100.0 * p / maximum).collect();
+                fitness.push(mean_of_trials(&scores));
+            } else {
+                part.rngs[i].set_word_pos(positions[i]);
+                let network = part.networks.network(j);
+                match TrialRunner::new(settings, task).and_then(|mut r| r.evaluate(&network, &mut part.rngs[i])) {
+                    Ok(f) => fitness.push(f),
+                    Err(e) => {
+                        failed = Some(e);
+                        break;
+                    }
+                }
+            }
         }
+        first += part.range.len() * per;
+        results.push(failed.map_or(Ok(fitness), Err));
     }
-    Ok(fitness)
+    Ok(results)
 }
 
 /// Flies a [`TrialBatch`] as `trial.cu` says: a GPU ([`CudaTrials`]) or
