@@ -4,6 +4,8 @@
 //!
 //! - `the_kernel_path_on_the_host_gives_the_native_grid` (always): the
 //!   GPU path's plumbing, with the kernel built for the host;
+//! - `the_bench_times_the_kernel_beside_native` (always): `bench`'s kernel
+//!   rows, the host build standing in for the GPU;
 //! - `nvrtc_compiles_the_trial_kernel`: a `cuda` build and NVRTC (no GPU);
 //! - `the_gpu_gives_the_scalar_paths_bits`: a `cuda` build, the driver,
 //!   NVRTC and a device; the kernel's fitness on the GPU against the scalar
@@ -111,6 +113,35 @@ fn the_gpu_grid_is_byte_identical_to_native() -> Result<(), Failed> {
     Ok(())
 }
 
+/// `bench`'s kernel rows, with the kernel built for the host standing in
+/// for the GPU: a row per size, beside `native`.
+fn the_bench_times_the_kernel_beside_native() -> Result<(), Failed> {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_psa-esp"))
+        .env(SIMD_VARIABLE, KERNEL_ON_HOST)
+        .args(["bench", "--steps", "500", "--rounds", "1", "--networks", "16"])
+        .args(["--generations", "2", "--kernel-networks", "8,24", "--json"])
+        .output()
+        .map_err(|e| e.to_string())?;
+    if !output.status.success() {
+        return Err(String::from_utf8_lossy(&output.stderr).into_owned().into());
+    }
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).map_err(|e| e.to_string())?;
+    let kernel = &json["cuda_kernel"];
+    let rows = kernel["rows"].as_array().ok_or("no kernel rows")?;
+    let sizes: Vec<u64> = rows.iter().filter_map(|r| r["networks"].as_u64()).collect();
+    if sizes != [8, 24] || !kernel["device"].as_str().is_some_and(|d| d.contains("host")) {
+        return Err(format!("unexpected kernel rows: {kernel}").into());
+    }
+    for row in rows {
+        for key in ["kernel_ns_per_network_step", "native_ns_per_network_step"] {
+            if !row[key].as_f64().is_some_and(|ns| ns.is_finite() && ns > 0.0) {
+                return Err(format!("{key} is not a time: {row}").into());
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Without a GPU (or NVRTC, or a `cuda` build), `--backend cuda` exits 2
 /// with the missing piece named, before writing anything.
 fn the_cuda_backend_fails_cleanly_without_a_gpu(why: String) -> Result<(), Failed> {
@@ -146,6 +177,10 @@ fn main() {
         Trial::test(
             "the_kernel_path_on_the_host_gives_the_native_grid",
             the_kernel_path_on_the_host_gives_the_native_grid,
+        ),
+        Trial::test(
+            "the_bench_times_the_kernel_beside_native",
+            the_bench_times_the_kernel_beside_native,
         ),
         Trial::test("nvrtc_compiles_the_trial_kernel", nvrtc_compiles_the_trial_kernel)
             .with_ignored_flag(needs(&nvrtc) && std::env::var_os(REQUIRE_NVRTC).is_none()),

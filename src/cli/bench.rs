@@ -14,6 +14,7 @@ use anyhow::Result;
 use multiversion::multiversion;
 use serde::Serialize;
 
+use super::bench_kernel::{kernel_rows, KERNEL_NETWORKS};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
 use crate::evolution::evaluate_all;
 use crate::evolution::operators::random_genes;
@@ -44,6 +45,11 @@ pub struct BenchArgs {
     /// hundredths of a second, whose speed-ups scatter (at most 100,000).
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(2..=100_000))]
     pub generations: u64,
+    /// Networks per launch of the cuda kernel's rows, beside `native`
+    /// (measured only where a GPU is, or with PSA_ESP_SIMD=kernel-host).
+    #[arg(long, value_delimiter = ',', default_values_t = KERNEL_NETWORKS,
+          value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub kernel_networks: Vec<u64>,
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
@@ -344,6 +350,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
     let replicate = replicate_workload(generations)?.scaling(args.rounds)?;
     // Long enough that the set-up before the first generation does not count.
     let overhead = algorithm_overhead(5 * generations, args.rounds)?;
+    let kernel = kernel_rows(&args.kernel_networks, args.rounds)?;
     let machine = machine();
     if args.json {
         let out = serde_json::json!({
@@ -360,6 +367,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             "evolve": evolve,
             "replicate": replicate,
             "algorithm_overhead": overhead,
+            "cuda_kernel": kernel,
         });
         say!("{}", serde_json::to_string_pretty(&out)?);
     } else {
@@ -439,6 +447,29 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             overhead.percent,
             overhead.description
         );
+        match &kernel.unavailable {
+            Some(why) => say!("cuda kernel: not measured: {why}"),
+            None => {
+                say!(
+                    "cuda kernel on {} against native batched on 1 thread (task 1, one launch per round, median):",
+                    kernel.device
+                );
+                say!(
+                    "{:>10} {:>22} {:>22}",
+                    "networks",
+                    "kernel ns/net-step",
+                    "native ns/net-step"
+                );
+                for row in &kernel.rows {
+                    say!(
+                        "{:>10} {:>22.3} {:>22.3}",
+                        row.networks,
+                        row.kernel_ns_per_network_step,
+                        row.native_ns_per_network_step
+                    );
+                }
+            }
+        }
     }
     Ok(0)
 }

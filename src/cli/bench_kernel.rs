@@ -1,0 +1,106 @@
+//! `bench`'s rows for the cuda path's trial kernel: ns per network-step on
+//! the GPU beside the `native` batched path, at several networks per
+//! launch (400, one generation of one run; 4,000; 312,000, one generation
+//! of every run of the paper grid).
+
+use std::time::Instant;
+
+use anyhow::Result;
+use serde::Serialize;
+
+use super::bench::random_networks;
+use super::bench_runs::median;
+use crate::experiment::{KERNEL_ON_HOST, SIMD_VARIABLE};
+use crate::network::Network;
+use crate::physics::{BackendKind, PlanarBody};
+use crate::psa::cuda::{prepare, CudaTrials, HostTrials, TrialFlier};
+use crate::psa::{BatchRunner, PsaSettings, Task};
+
+/// Networks per launch of the kernel rows, by default.
+pub const KERNEL_NETWORKS: [u64; 3] = [400, 4_000, 312_000];
+
+/// One size of the kernel rows.
+#[derive(Debug, Clone, Serialize)]
+pub struct KernelTiming {
+    /// Networks per launch.
+    pub networks: u64,
+    /// ns per network-step of one launch (the median round), copies in and out included.
+    pub kernel_ns_per_network_step: f64,
+    /// ns per network-step of the same networks on the `native` batched path, 1 thread.
+    pub native_ns_per_network_step: f64,
+}
+
+/// The kernel rows, or why they could not be measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct KernelBench {
+    /// What flew the trials (the GPU, or the host build with `PSA_ESP_SIMD=kernel-host`).
+    pub device: String,
+    /// One row per size; empty where `unavailable` says why.
+    pub rows: Vec<KernelTiming>,
+    /// Why there is no GPU, where there is none.
+    pub unavailable: Option<String>,
+}
+
+/// The GPU, or the kernel built for the host with `PSA_ESP_SIMD=kernel-host`
+/// (to exercise these rows without a GPU), or why neither.
+fn flier() -> std::result::Result<Box<dyn TrialFlier>, String> {
+    if std::env::var(SIMD_VARIABLE).is_ok_and(|v| v == KERNEL_ON_HOST) {
+        return Ok(Box::new(HostTrials));
+    }
+    CudaTrials::open()
+        .map(|gpu| Box::new(gpu) as Box<dyn TrialFlier>)
+        .map_err(|e| e.to_string())
+}
+
+/// Times the kernel and `native` at each of `sizes` networks per launch,
+/// `rounds` rounds each (the median is kept). Without a GPU, no row, and
+/// the reason.
+pub fn kernel_rows(sizes: &[u64], rounds: u64) -> Result<KernelBench> {
+    let flier = match flier() {
+        Ok(flier) => flier,
+        Err(why) => {
+            return Ok(KernelBench {
+                device: "none".into(),
+                rows: Vec::new(),
+                unavailable: Some(why),
+            })
+        }
+    };
+    let settings = PsaSettings {
+        backend: BackendKind::Native,
+        ..PsaSettings::default()
+    };
+    let task = Task::StopRotation;
+    let body = PlanarBody::new(&settings.body.model()?, &settings.physics)?;
+    // The batched path itself, not an evaluator (which PSA_ESP_SIMD=kernel-host would send to the kernel).
+    let native = BatchRunner::new(&settings, task)?;
+    let mut rows = Vec::new();
+    for &size in sizes {
+        let networks = random_networks(size)?;
+        let refs: Vec<&Network> = networks.iter().collect();
+        let network_steps = (size as usize * settings.steps * settings.trials) as f64;
+        let (mut kernel, mut cpu) = (Vec::new(), Vec::new());
+        for round in 0..rounds {
+            let mut streams: Vec<_> = (0..networks.len())
+                .map(|j| crate::rng::stream(round, &[j as u64]))
+                .collect();
+            let batch = prepare(&settings, &body, task, &refs[..], 0..refs.len(), &mut streams.clone())?;
+            let start = Instant::now();
+            flier.fly(&batch)?;
+            kernel.push(start.elapsed().as_secs_f64() * 1e9 / network_steps);
+            let start = Instant::now();
+            native.evaluate(&refs[..], 0..refs.len(), &mut streams)?;
+            cpu.push(start.elapsed().as_secs_f64() * 1e9 / network_steps);
+        }
+        rows.push(KernelTiming {
+            networks: size,
+            kernel_ns_per_network_step: median(kernel),
+            native_ns_per_network_step: median(cpu),
+        });
+    }
+    Ok(KernelBench {
+        device: flier.describe(),
+        rows,
+        unavailable: None,
+    })
+}
