@@ -54,7 +54,7 @@ fn small_grid(backend: &str, out: &std::path::Path) -> std::process::Output {
 /// [`small_grid`] with `PSA_ESP_SIMD` set to `path`, if given.
 fn small_grid_with(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::process::Output {
     let out = out.to_str().unwrap();
-    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_psa-esp"));
+    let mut command = std::process::Command::new(common::binary());
     if let Some(path) = path {
         command.env(SIMD_VARIABLE, path);
     }
@@ -116,7 +116,7 @@ fn the_gpu_grid_is_byte_identical_to_native() -> Result<(), Failed> {
 /// `bench`'s kernel rows, with the kernel built for the host standing in
 /// for the GPU: a row per size, beside `native`.
 fn the_bench_times_the_kernel_beside_native() -> Result<(), Failed> {
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_psa-esp"))
+    let output = std::process::Command::new(common::binary())
         .env(SIMD_VARIABLE, KERNEL_ON_HOST)
         .args(["bench", "--steps", "500", "--rounds", "1", "--networks", "16"])
         .args(["--generations", "2", "--kernel-networks", "8,24", "--json"])

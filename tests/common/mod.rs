@@ -7,7 +7,13 @@ use std::process::{Command, Output};
 
 /// Runs `psa-esp` with `args`.
 pub fn psa_esp(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_psa-esp")).args(args).output().unwrap()
+    Command::new(binary()).args(args).output().unwrap()
+}
+
+/// The `psa-esp` binary: `PSA_ESP_BIN` where set (test binaries carried to
+/// another machine, such as a GPU's), else the one cargo built.
+pub fn binary() -> PathBuf {
+    std::env::var_os("PSA_ESP_BIN").map_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_psa-esp")), PathBuf::from)
 }
 
 /// The arguments of a tiny grid (one seed of baseline on tasks 1-3, five
