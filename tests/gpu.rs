@@ -82,35 +82,32 @@ fn small_grid_with(backend: &str, out: &std::path::Path, path: Option<&str>) -> 
     command.output().unwrap()
 }
 
-/// The GPU path's plumbing without a GPU: the small grid in lockstep with
-/// every trial flown by the kernel built for the host (`PSA_ESP_SIMD=kernel-host`,
-/// a generation per call, as a GPU gets them) against `native`, file for file.
-fn the_kernel_path_on_the_host_gives_the_native_grid() -> Result<(), Failed> {
+/// Asserts that the small grid writes the same files run as `a` and as
+/// `b`, each a `--backend` and a `PSA_ESP_SIMD` value, if any.
+fn assert_same_grids(a: (&str, Option<&str>), b: (&str, Option<&str>)) -> Result<(), Failed> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let (native, kernel) = (dir.path().join("native"), dir.path().join("kernel"));
-    for (path, out) in [(None, &native), (Some(KERNEL_ON_HOST), &kernel)] {
-        let output = small_grid_with("native", out, path);
+    let outs = [dir.path().join("a"), dir.path().join("b")];
+    for ((backend, path), out) in [a, b].into_iter().zip(&outs) {
+        let output = small_grid_with(backend, out, path);
         if !output.status.success() {
             let stderr = String::from_utf8_lossy(&output.stderr);
-            return Err(format!("replicate with {path:?}: {stderr}").into());
+            return Err(format!("replicate --backend {backend} with {path:?}: {stderr}").into());
         }
     }
-    common::assert_same_runs(&native, &kernel);
+    common::assert_same_runs(&outs[0], &outs[1]);
     Ok(())
 }
 
+/// The GPU path's plumbing without a GPU: the small grid in lockstep with
+/// every trial flown by the kernel built for the host (`PSA_ESP_SIMD=kernel-host`,
+/// a round's networks of a configuration and task per call, as a GPU gets
+/// them) against `native`, file for file.
+fn the_kernel_path_on_the_host_gives_the_native_grid() -> Result<(), Failed> {
+    assert_same_grids(("native", None), ("native", Some(KERNEL_ON_HOST)))
+}
+
 fn the_gpu_grid_is_byte_identical_to_native() -> Result<(), Failed> {
-    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let (native, cuda) = (dir.path().join("native"), dir.path().join("cuda"));
-    for (backend, out) in [("native", &native), ("cuda", &cuda)] {
-        let output = small_grid(backend, out);
-        if !output.status.success() {
-            let stderr = String::from_utf8_lossy(&output.stderr);
-            return Err(format!("replicate --backend {backend}: {stderr}").into());
-        }
-    }
-    common::assert_same_runs(&native, &cuda);
-    Ok(())
+    assert_same_grids(("native", None), ("cuda", None))
 }
 
 /// `bench`'s kernel rows, with the kernel built for the host standing in

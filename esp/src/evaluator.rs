@@ -77,11 +77,22 @@ pub trait Evaluator: Sync {
         worker: &mut Self::Worker,
         parts: &[Part<'_, S>],
     ) -> Vec<Result<Vec<f64>>> {
-        parts
-            .iter()
-            .map(|part| self.evaluate_batch(worker, part.networks, part.range.clone(), part.streams))
-            .collect()
+        evaluate_each_part(self, worker, parts)
     }
+}
+
+/// [`Evaluator::evaluate_parts`] part by part, through
+/// [`Evaluator::evaluate_batch`]: the default, and what an evaluator that
+/// takes parts together only sometimes falls back on.
+pub fn evaluate_each_part<E: Evaluator + ?Sized, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    worker: &mut E::Worker,
+    parts: &[Part<'_, S>],
+) -> Vec<Result<Vec<f64>>> {
+    parts
+        .iter()
+        .map(|part| evaluator.evaluate_batch(worker, part.networks, part.range.clone(), part.streams))
+        .collect()
 }
 
 /// Networks `range` of `networks`, network `j` with `streams.stream(j)`:

@@ -53,7 +53,7 @@ pub use ask::{AskPurpose, AskTell, Asked};
 pub use error::{RunError, SettingsError};
 pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, StagnationRule, TopologyMode};
 pub use esp_run::EspRun;
-pub use evaluator::{evaluate_all, evaluate_each, Evaluator, FnEvaluator, Part};
+pub use evaluator::{evaluate_all, evaluate_each, evaluate_each_part, Evaluator, FnEvaluator, Part};
 pub use hill_climb::{HillClimb, HillClimbRun, HillClimbSettings, MutationRates};
 pub use record::{Champion, Control, Ending, GenerationRecord, LesionOutcome, RunResult, StopAt};
 

@@ -5,7 +5,7 @@ use std::sync::{Arc, OnceLock};
 
 use anyhow::Result;
 
-use crate::evolution::{evaluate_each, Evaluator, Part};
+use crate::evolution::{evaluate_each, evaluate_each_part, Evaluator, Part};
 use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
@@ -88,13 +88,7 @@ impl PsaEvaluator {
             _ => None,
         };
         let ode_lockstep = OdeLockstepRunner::supports(&settings);
-        let native = settings.backend == BackendKind::Native;
-        let on_host = std::env::var(SIMD_VARIABLE).is_ok_and(|v| v == KERNEL_ON_HOST);
-        let kernel = match FLIER.get() {
-            Some(flier) if native => Some(flier.clone()),
-            _ if native && on_host => Some(Arc::new(HostTrials) as Arc<dyn TrialFlier>),
-            _ => None,
-        };
+        let kernel = FLIER.get().filter(|_| settings.backend == BackendKind::Native).cloned();
         let evaluator = PsaEvaluator {
             settings,
             task,
@@ -105,7 +99,7 @@ impl PsaEvaluator {
         Ok(match std::env::var(SIMD_VARIABLE) {
             Err(_) => evaluator,
             Ok(choice) if choice == "scalar" => evaluator.with_batching(None).with_ode_lockstep(false),
-            Ok(choice) if choice == KERNEL_ON_HOST => evaluator,
+            Ok(choice) if choice == KERNEL_ON_HOST => evaluator.with_kernel_on_host(),
             Ok(choice) => {
                 evaluator.with_batching(Some(choice.parse().map_err(|e| {
                     anyhow::anyhow!("{SIMD_VARIABLE}={choice:?}: {e} (or scalar for the scalar path)")
@@ -126,6 +120,16 @@ impl PsaEvaluator {
                 .zip(level)
                 .map(|(b, l)| b.with_level(l)),
         };
+        self
+    }
+
+    /// The same evaluator on `native` flying its trials through the cuda
+    /// kernel built for the host (where no GPU is set already), for
+    /// checks (the same results, slowly). Other backends are unchanged.
+    pub fn with_kernel_on_host(mut self) -> PsaEvaluator {
+        if self.settings.backend == BackendKind::Native && self.kernel.is_none() {
+            self.kernel = Some(Arc::new(HostTrials));
+        }
         self
     }
 
@@ -188,10 +192,7 @@ impl Evaluator for PsaEvaluator {
         parts: &[Part<'_, S>],
     ) -> Vec<Result<Vec<f64>>> {
         let Some(flier) = &self.kernel else {
-            return parts
-                .iter()
-                .map(|part| self.evaluate_batch(worker, part.networks, part.range.clone(), part.streams))
-                .collect();
+            return evaluate_each_part(self, worker, parts);
         };
         // Every part's trials in one flight of the kernel: one GPU launch.
         let mut rngs: Vec<Vec<Stream>> = parts

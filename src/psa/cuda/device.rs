@@ -171,10 +171,9 @@ mod gpu {
                     finite: Vec::new(),
                 });
             }
-            let count_arg = i32::try_from(count)
-                .map_err(|_| PsaError::Setting(format!("{count} trials are too many for one launch")))?;
-            let blocks = u32::try_from(count.div_ceil(THREADS_PER_BLOCK as usize))
-                .map_err(|_| PsaError::Setting(format!("{count} trials are too many for one launch")))?;
+            let too_many = |_| PsaError::Setting(format!("{count} trials are too many for one launch"));
+            let count_arg = i32::try_from(count).map_err(too_many)?;
+            let blocks = u32::try_from(count.div_ceil(THREADS_PER_BLOCK as usize)).map_err(too_many)?;
             let _one_at_a_time = self
                 .launch
                 .lock()

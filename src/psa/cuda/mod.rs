@@ -148,43 +148,66 @@ pub fn prepare<S: NetworkSet + ?Sized>(
     range: std::ops::Range<usize>,
     rngs: &mut [Stream],
 ) -> Result<TrialBatch, PsaError> {
-    assert_eq!(range.len(), rngs.len(), "one stream per network");
-    let params = KernelParams::new(settings, body)?;
-    let mut weights = Vec::new();
-    let mut trials = Vec::with_capacity(range.len() * settings.trials);
-    for (j, rng) in range.zip(rngs.iter_mut()) {
-        let (inputs, outputs) = networks.shape(j);
-        TrialRunner::check_shape(inputs, outputs)?;
-        let offset = weights.len();
-        let mut hidden: usize = 0;
-        for k in (0..networks.hidden(j)).filter(|&k| !networks.is_lesioned(j, k)) {
-            weights.extend_from_slice(&networks.neuron(j, k)[..INPUT_COUNT + THRUSTER_COUNT]);
-            hidden += 1;
-        }
-        let too_big = |what: &str| PsaError::Setting(format!("the cuda kernel's batch is too large ({what})"));
-        let offset = i32::try_from(offset).map_err(|_| too_big("weights"))?;
-        let hidden = i32::try_from(hidden).map_err(|_| too_big("hidden neurons"))?;
-        for _ in 0..settings.trials {
-            let (start, target) = settings.tasks.start_and_target(task, settings.random_init, rng);
-            start.validate()?;
-            let state = PlanarState::from_body_state(&start);
-            trials.push(KernelTrial {
-                position: state.position,
-                velocity: state.velocity,
-                quaternion: state.quaternion,
-                omega: state.omega,
-                target: [target.x, target.y, target.heading],
-                noise_state: expand(settings.noise.draw_seed(rng)),
-                weights: offset,
-                hidden,
-            });
-        }
+    let mut batch = TrialBatch::new(settings, body)?;
+    batch.append(settings, task, networks, range, rngs)?;
+    Ok(batch)
+}
+
+impl TrialBatch {
+    /// A batch of no trials yet, with the parameters of `settings` (already
+    /// validated for the task) on `body`.
+    pub fn new(settings: &PsaSettings, body: &PlanarBody) -> Result<TrialBatch, PsaError> {
+        Ok(TrialBatch {
+            params: KernelParams::new(settings, body)?,
+            weights: Vec::new(),
+            trials: Vec::new(),
+        })
     }
-    Ok(TrialBatch {
-        params,
-        weights,
-        trials,
-    })
+
+    /// Adds the weights and trials of networks `range` of `networks`, as
+    /// [`prepare`] makes them, after those already in the batch.
+    ///
+    /// # Panics
+    /// If `range` and `rngs` differ in length.
+    pub fn append<S: NetworkSet + ?Sized>(
+        &mut self,
+        settings: &PsaSettings,
+        task: Task,
+        networks: &S,
+        range: std::ops::Range<usize>,
+        rngs: &mut [Stream],
+    ) -> Result<(), PsaError> {
+        assert_eq!(range.len(), rngs.len(), "one stream per network");
+        let too_big = |what: &str| PsaError::Setting(format!("the cuda kernel's batch is too large ({what})"));
+        for (j, rng) in range.zip(rngs.iter_mut()) {
+            let (inputs, outputs) = networks.shape(j);
+            TrialRunner::check_shape(inputs, outputs)?;
+            let offset = i32::try_from(self.weights.len()).map_err(|_| too_big("weights"))?;
+            let mut hidden: usize = 0;
+            for k in (0..networks.hidden(j)).filter(|&k| !networks.is_lesioned(j, k)) {
+                self.weights
+                    .extend_from_slice(&networks.neuron(j, k)[..INPUT_COUNT + THRUSTER_COUNT]);
+                hidden += 1;
+            }
+            let hidden = i32::try_from(hidden).map_err(|_| too_big("hidden neurons"))?;
+            for _ in 0..settings.trials {
+                let (start, target) = settings.tasks.start_and_target(task, settings.random_init, rng);
+                start.validate()?;
+                let state = PlanarState::from_body_state(&start);
+                self.trials.push(KernelTrial {
+                    position: state.position,
+                    velocity: state.velocity,
+                    quaternion: state.quaternion,
+                    omega: state.omega,
+                    target: [target.x, target.y, target.heading],
+                    noise_state: expand(settings.noise.draw_seed(rng)),
+                    weights: offset,
+                    hidden,
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The fitness of networks `range` of `networks` on `task`, in % of the
@@ -247,23 +270,9 @@ pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
         .iter()
         .map(|p| p.rngs.iter().map(|r| r.get_word_pos()).collect())
         .collect();
-    let mut batch = TrialBatch {
-        params: KernelParams::new(settings, &body)?,
-        weights: Vec::new(),
-        trials: Vec::new(),
-    };
+    let mut batch = TrialBatch::new(settings, &body)?;
     for part in parts.iter_mut() {
-        let mut one = prepare(settings, &body, task, part.networks, part.range.clone(), part.rngs)?;
-        let shift = i32::try_from(batch.weights.len())
-            .map_err(|_| PsaError::Setting("the cuda kernel's batch is too large (weights)".into()))?;
-        for trial in &mut one.trials {
-            trial.weights = trial
-                .weights
-                .checked_add(shift)
-                .ok_or_else(|| PsaError::Setting("the cuda kernel's batch is too large (weights)".into()))?;
-        }
-        batch.weights.append(&mut one.weights);
-        batch.trials.append(&mut one.trials);
+        batch.append(settings, task, part.networks, part.range.clone(), part.rngs)?;
     }
     let flown = fly(&batch)?;
     let maximum = settings.fitness.maximum(settings.steps);
