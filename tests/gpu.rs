@@ -46,13 +46,9 @@ fn the_gpu_gives_the_scalar_paths_bits() -> Result<(), Failed> {
     Ok(())
 }
 
-/// A small grid with noise and random starts: `replicate` on `backend`.
-fn small_grid(backend: &str, out: &std::path::Path) -> std::process::Output {
-    small_grid_with(backend, out, None)
-}
-
-/// [`small_grid`] with `PSA_ESP_SIMD` set to `path`, if given.
-fn small_grid_with(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::process::Output {
+/// A small grid with noise and random starts: `replicate` on `backend`,
+/// with `PSA_ESP_SIMD` set to `path`, if given.
+fn small_grid(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::process::Output {
     let out = out.to_str().unwrap();
     let mut command = std::process::Command::new(common::binary());
     if let Some(path) = path {
@@ -88,7 +84,7 @@ fn assert_same_grids(a: (&str, Option<&str>), b: (&str, Option<&str>)) -> Result
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let outs = [dir.path().join("a"), dir.path().join("b")];
     for ((backend, path), out) in [a, b].into_iter().zip(&outs) {
-        let output = small_grid_with(backend, out, path);
+        let output = small_grid(backend, out, path);
         if !output.status.success() {
             let stderr = String::from_utf8_lossy(&output.stderr);
             return Err(format!("replicate --backend {backend} with {path:?}: {stderr}").into());
@@ -144,7 +140,7 @@ fn the_bench_times_the_kernel_beside_native() -> Result<(), Failed> {
 fn the_cuda_backend_fails_cleanly_without_a_gpu(why: String) -> Result<(), Failed> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let out = dir.path().join("grid");
-    let output = small_grid("cuda", &out);
+    let output = small_grid("cuda", &out, None);
     let stderr = String::from_utf8_lossy(&output.stderr);
     if output.status.code() != Some(2) || !stderr.contains(&why) || stderr.contains("panicked") {
         return Err(format!(

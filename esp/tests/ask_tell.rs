@@ -5,8 +5,8 @@ use esp_neuroevolution::lockstep::{evaluate_jobs, lockstep, Job};
 use esp_neuroevolution::network::{Network, NetworkSet};
 use esp_neuroevolution::rng::Stream;
 use esp_neuroevolution::{
-    evaluate_all, AskPurpose, AskTell, Control, Ending, Esp, EspSettings, Evaluator, FnEvaluator, GenerationRecord,
-    HillClimb, HillClimbSettings, Part, RunError, RunResult, StopAt, TopologyMode,
+    evaluate_all, evaluate_each_part, AskPurpose, AskTell, Control, Ending, Esp, EspSettings, Evaluator, FnEvaluator,
+    GenerationRecord, HillClimb, HillClimbSettings, Part, RunError, RunResult, StopAt, TopologyMode,
 };
 use rand::RngExt;
 
@@ -381,13 +381,7 @@ impl<E: Evaluator> Evaluator for Together<E> {
         parts: &[Part<'_, S>],
     ) -> Vec<anyhow::Result<Vec<f64>>> {
         self.calls.lock().unwrap().push(parts.len());
-        parts
-            .iter()
-            .map(|p| {
-                self.inner
-                    .evaluate_batch(worker, p.networks, p.range.clone(), p.streams)
-            })
-            .collect()
+        evaluate_each_part(&self.inner, worker, parts)
     }
 }
 

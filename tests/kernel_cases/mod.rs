@@ -97,31 +97,20 @@ pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Re
         let refs: Vec<&Network> = networks.iter().collect();
         evaluate_with(settings, task, &refs[..], 0..refs.len(), &mut streams(seeds), &fly).unwrap()
     };
+    let check = |settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>, what: &str| {
+        assert_bit_identical(
+            &scalar_fitness(settings, task, seeds.clone()),
+            &kernel(settings, task, seeds),
+            what,
+        )
+    };
     let clean = native(PsaSettings::default());
     for task in Task::ALL {
-        let seeds = 9000..9400;
-        let what = format!("clean task {task}");
-        assert_bit_identical(
-            &scalar_fitness(&clean, task, seeds.clone()),
-            &kernel(&clean, task, seeds),
-            &what,
-        );
+        check(&clean, task, 9000..9400, &format!("clean task {task}"));
     }
     let noisy = noisy_settings();
     for task in [Task::StopRotation, Task::StopAtPosition] {
-        let seeds = 9500..9700;
-        let what = format!("noisy task {task}");
-        assert_bit_identical(
-            &scalar_fitness(&noisy, task, seeds.clone()),
-            &kernel(&noisy, task, seeds),
-            &what,
-        );
+        check(&noisy, task, 9500..9700, &format!("noisy task {task}"));
     }
-    let original = original_fitness_settings();
-    let seeds = 9800..9900;
-    assert_bit_identical(
-        &scalar_fitness(&original, Task::Turn, seeds.clone()),
-        &kernel(&original, Task::Turn, seeds),
-        "original fitness",
-    );
+    check(&original_fitness_settings(), Task::Turn, 9800..9900, "original fitness");
 }

@@ -5,9 +5,9 @@
 //! The CUDA libraries are loaded when first asked for (`cudarc`'s dynamic
 //! loading), so a build with the feature runs on machines without them;
 //! `cudarc` panics when a library it calls is absent, so [`CudaTrials::open`]
-//! probes for the driver and NVRTC first and says which is missing. Its
-//! kernel launch is the one `unsafe` call of this module, the only `unsafe`
-//! of the project outside `ode-sys` and the ODE wrapper.
+//! probes for the driver and NVRTC first and says which is missing. Those
+//! two probes and the kernel launch are this module's `unsafe` calls, the
+//! only `unsafe` of the project outside `ode-sys` and the ODE wrapper.
 
 use std::fmt;
 
