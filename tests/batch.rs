@@ -10,8 +10,9 @@ use kernel_cases::{
     assert_bit_identical, native, noisy_settings, original_fitness_settings, random_network, scalar_fitness, streams,
 };
 use psa_esp::network::Network;
-use psa_esp::numeric::SimdLevel;
+use psa_esp::numeric::{Exponential, SimdLevel};
 use psa_esp::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
+use psa_esp::psa::cuda::{evaluate_with, fly_on_host};
 use psa_esp::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
 use psa_esp::rng::stream;
 
@@ -62,6 +63,72 @@ fn batched_fitness_equals_the_scalar_path_with_noise_random_starts_trials_and_th
     let original = original_fitness_settings();
     let (scalar, batched) = both_paths(&original, Task::Turn, 7000..7300, SimdLevel::detect());
     assert_bit_identical(&scalar, &batched, "original fitness");
+}
+
+/// Networks whose thrusters turn on the last bits of one logistic unit:
+/// hidden unit 0 sees only the bias (net input `x`), unit 1 nothing (its
+/// output is 1/2 with either exponential), and output `o` gets
+/// `w (h0 - c)` with `c` the accurate exponential's h0 and `w` chosen to
+/// make the fast one's difference 10. So the accurate exponential gives
+/// that thruster a command of about 1/2, the fast one about 0 or 1.
+fn networks_that_tell_the_exponentials_apart() -> Vec<Network> {
+    use psa_esp::numeric::sigmoid_with;
+    let mut networks = Vec::new();
+    for (i, x) in [0.5, 1.25, -0.75, 2.0, -1.5].into_iter().enumerate() {
+        let (accurate, fast) = (
+            sigmoid_with(x, Exponential::Accurate),
+            sigmoid_with(x, Exponential::Fast),
+        );
+        assert_ne!(accurate, fast, "the exponentials agree at {x}");
+        let w = 10.0 / (fast - accurate);
+        let o = i % 4;
+        let mut genes = vec![0.0; 2 * 11];
+        genes[6] = x;
+        genes[7 + o] = w;
+        genes[11 + 7 + o] = -2.0 * w * accurate;
+        networks.push(Network::from_genes(7, 4, genes).unwrap());
+    }
+    networks
+}
+
+#[test]
+fn both_paths_fly_the_exponential_the_settings_name() {
+    let fast = native(PsaSettings::default());
+    assert_eq!(fast.exponential, Exponential::Fast);
+    let accurate = PsaSettings {
+        exponential: Exponential::Accurate,
+        ..fast.clone()
+    };
+    let networks = networks_that_tell_the_exponentials_apart();
+    let refs: Vec<&Network> = networks.iter().collect();
+    let rngs = || streams(0..networks.len() as u64);
+    let scalar = |settings: &PsaSettings, task: Task| -> Vec<f64> {
+        let mut runner = TrialRunner::new(settings, task).unwrap();
+        (networks.iter().zip(&mut rngs()))
+            .map(|(n, rng)| runner.evaluate(n, rng).unwrap())
+            .collect()
+    };
+    let batched = |settings: &PsaSettings, task: Task| {
+        let runner = BatchRunner::new(settings, task).unwrap();
+        runner.evaluate(&refs[..], 0..refs.len(), &mut rngs()).unwrap()
+    };
+    let kernel = |settings: &PsaSettings, task: Task| {
+        evaluate_with(settings, task, &refs[..], 0..refs.len(), &mut rngs(), fly_on_host).unwrap()
+    };
+    let mut moved = 0;
+    for task in Task::ALL {
+        let (fast_scalar, accurate_scalar) = (scalar(&fast, task), scalar(&accurate, task));
+        for (settings, reference, what) in [(&fast, &fast_scalar, "fast"), (&accurate, &accurate_scalar, "accurate")] {
+            assert_bit_identical(reference, &batched(settings, task), &format!("{what}, batched"));
+            assert_bit_identical(
+                reference,
+                &kernel(settings, task),
+                &format!("{what}, cuda kernel on the host"),
+            );
+        }
+        moved += fast_scalar.iter().zip(&accurate_scalar).filter(|(a, b)| a != b).count();
+    }
+    assert!(moved >= 3, "only {moved} fitness values told the exponentials apart");
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! Network files: exact round trips, and a clear error for each kind of malformed file.
 
 use psa_esp::network::Network;
+use psa_esp::numeric::Exponential;
 use psa_esp::psa::{NetworkFile, PsaSettings, Task};
 use rand::RngExt;
 
@@ -52,6 +53,23 @@ fn valid_json() -> serde_json::Value {
         serde_json::Map::new(),
     );
     serde_json::to_value(&file).unwrap()
+}
+
+#[test]
+fn files_from_before_the_exponential_setting_load_with_the_accurate_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("net.json");
+    let mut old = valid_json();
+    old["problem"].as_object_mut().unwrap().remove("exponential").unwrap();
+    std::fs::write(&path, old.to_string()).unwrap();
+    let (file, _) = NetworkFile::load(&path).unwrap();
+    assert_eq!(file.problem.unwrap().exponential, Exponential::Accurate);
+    // A file that names it keeps it.
+    let new = valid_json();
+    assert_eq!(new["problem"]["exponential"], "fast");
+    std::fs::write(&path, new.to_string()).unwrap();
+    let (file, _) = NetworkFile::load(&path).unwrap();
+    assert_eq!(file.problem.unwrap().exponential, Exponential::Fast);
 }
 
 #[test]

@@ -8,6 +8,7 @@
 
 use std::borrow::{Borrow, Cow};
 
+use crate::math::{sigmoid_with, Exponential};
 use thiserror::Error;
 
 /// Errors building a network.
@@ -28,8 +29,9 @@ pub enum NetworkError {
     },
 }
 
-/// The logistic sigmoid 1 / (1 + e^-x), with our own `exp` (see
-/// [`crate::math`]) so that every path computes the same bits.
+/// The logistic sigmoid 1 / (1 + e^-x), with our own `exp` (the default
+/// [`Exponential`]; see [`crate::math`]) so that every path computes the
+/// same bits.
 #[inline]
 pub fn sigmoid(x: f64) -> f64 {
     crate::math::sigmoid(x)
@@ -208,6 +210,16 @@ impl Network {
     /// If the slices' lengths differ from the network's inputs and outputs.
     #[inline(always)]
     pub fn activate(&self, input: &[f64], output: &mut [f64]) {
+        self.activate_with(Exponential::default(), input, output);
+    }
+
+    /// [`Network::activate`] with the logistic units' exponential
+    /// `exponential`.
+    ///
+    /// # Panics
+    /// As [`Network::activate`].
+    #[inline(always)]
+    pub fn activate_with(&self, exponential: Exponential, input: &[f64], output: &mut [f64]) {
         assert_eq!(input.len(), self.inputs, "input length");
         assert_eq!(output.len(), self.outputs, "output length");
         output.fill(0.0);
@@ -221,13 +233,13 @@ impl Network {
             for (w, x) in w_in.iter().zip(input).skip(1) {
                 activation = w.mul_add(*x, activation);
             }
-            let h = sigmoid(activation);
+            let h = sigmoid_with(activation, exponential);
             for (o, w) in output.iter_mut().zip(w_out) {
                 *o = h.mul_add(*w, *o);
             }
         }
         for o in output.iter_mut() {
-            *o = sigmoid(*o);
+            *o = sigmoid_with(*o, exponential);
         }
     }
 }

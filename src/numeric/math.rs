@@ -3,15 +3,17 @@
 //!
 //! `exp` and `atan2` are our own polynomial approximations (coefficients
 //! fitted by Chebyshev interpolation in 50-digit arithmetic), accurate to a
-//! few units in the last place: they are the definition of the logistic unit
-//! and the heading for every backend, so that results never depend on the
-//! C library's implementation of these functions. `ln` (fdlibm's) and the
+//! few units in the last place (the logistic unit's exponential is a
+//! setting, [`Exponential`](esp_neuroevolution::math::Exponential), whose
+//! default is shorter): they are the definition of the logistic unit and
+//! the heading for every backend, so that results never depend on the C
+//! library's implementation of these functions. `ln` (fdlibm's) and the
 //! sine and cosine of quarter turns (Taylor series) serve the noise
 //! generator's Box-Muller transform.
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, SQRT_2, TAU};
 
-pub use esp_neuroevolution::math::{exp, sigmoid};
+pub use esp_neuroevolution::math::{exp, sigmoid, sigmoid_with};
 use esp_neuroevolution::math::{horner, LN2_HI, LN2_LO};
 
 use super::Real;

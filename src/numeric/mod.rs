@@ -26,10 +26,10 @@ mod math;
 mod normal;
 
 pub use dispatch::SimdLevel;
-pub use esp_neuroevolution::math::Float;
 use esp_neuroevolution::math::TWO_52;
+pub use esp_neuroevolution::math::{Exponential, Float};
 pub use lanes::{LaneMask, Lanes, Words};
-pub use math::{atan2, clamp_unit, exp, fmod, ln, sigmoid, sin_cos_quarter_turns, wrap_angle};
+pub use math::{atan2, clamp_unit, exp, fmod, ln, sigmoid, sigmoid_with, sin_cos_quarter_turns, wrap_angle};
 pub use normal::{NoiseSource, Word};
 
 /// A real number, or a bundle of them computed lane by lane: the search

@@ -33,7 +33,9 @@ use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use std::ops::Range;
 
 use crate::network::NetworkSet;
-use crate::numeric::{clamp_unit, sigmoid, wrap_angle, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words};
+use crate::numeric::{
+    clamp_unit, sigmoid_with, wrap_angle, Exponential, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words,
+};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::Stream;
 
@@ -125,6 +127,7 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     assert!(G <= 2 || G >= THRUSTER_COUNT, "groups hold all four outputs");
     let s = flight.settings;
     let weights = flight.weights;
+    let e = s.exponential;
     let zero = V::<N>::splat(0.0);
     let mut points = zero;
     let mut heading_error = wrap_angle(state.heading() - target[2]);
@@ -140,7 +143,7 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
         let (paired, grouped) = (G == 2, G >= THRUSTER_COUNT);
         let mut k = 0;
         while paired && k + 2 <= weights.hidden {
-            let [h0, h1] = sigmoid_pair::<N, NG>(dot(weights, &inputs, k), dot(weights, &inputs, k + 1));
+            let [h0, h1] = sigmoid_pair::<N, NG>(dot(weights, &inputs, k), dot(weights, &inputs, k + 1), e);
             accumulate(weights, &mut outputs, h0, k);
             accumulate(weights, &mut outputs, h1, k + 1);
             k += 2;
@@ -150,29 +153,29 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
             for i in 0..G {
                 net[i] = dot(weights, &inputs, k + i);
             }
-            let h = sigmoid_group::<N, NG, G>(&net);
+            let h = sigmoid_group::<N, NG, G>(&net, e);
             for i in 0..G {
                 accumulate(weights, &mut outputs, h[i], k + i);
             }
             k += G;
         }
         for k in k..weights.hidden {
-            let h = sigmoid(dot(weights, &inputs, k));
+            let h = sigmoid_with(dot(weights, &inputs, k), e);
             accumulate(weights, &mut outputs, h, k);
         }
         if paired {
-            let [o0, o1] = sigmoid_pair::<N, NG>(outputs[0], outputs[1]);
-            let [o2, o3] = sigmoid_pair::<N, NG>(outputs[2], outputs[3]);
+            let [o0, o1] = sigmoid_pair::<N, NG>(outputs[0], outputs[1], e);
+            let [o2, o3] = sigmoid_pair::<N, NG>(outputs[2], outputs[3], e);
             outputs = [o0, o1, o2, o3];
         } else if grouped {
             // All four outputs in one group, padded with zeros.
             let mut net = [zero; G];
             net[..THRUSTER_COUNT].copy_from_slice(&outputs);
-            let o = sigmoid_group::<N, NG, G>(&net);
+            let o = sigmoid_group::<N, NG, G>(&net, e);
             outputs.copy_from_slice(&o[..THRUSTER_COUNT]);
         } else {
             for o in &mut outputs {
-                *o = sigmoid(*o);
+                *o = sigmoid_with(*o, e);
             }
         }
         // The logistic function's values lie in [0, 1] already (1 / (1 + e)
@@ -206,16 +209,16 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
 /// lanes: the two evaluations are independent dependency chains, so running
 /// them side by side keeps the SIMD units busy while each waits on its
 /// exponential and division. Every lane goes through exactly the operations
-/// of [`sigmoid`], so the values are those of two separate calls. (`N2` is a
+/// of [`sigmoid_with`], so the values are those of two separate calls. (`N2` is a
 /// parameter only because stable Rust cannot write `Lanes<{ 2 * N }>` in
 /// generic code.)
 #[inline(always)]
-fn sigmoid_pair<const N: usize, const N2: usize>(a: Lanes<N>, b: Lanes<N>) -> [Lanes<N>; 2] {
+fn sigmoid_pair<const N: usize, const N2: usize>(a: Lanes<N>, b: Lanes<N>, e: Exponential) -> [Lanes<N>; 2] {
     assert_eq!(N2, 2 * N, "a pair is two blocks wide");
     let mut both = Lanes::<N2>::splat(0.0);
     both.0[..N].copy_from_slice(&a.0);
     both.0[N..].copy_from_slice(&b.0);
-    let both = sigmoid(both);
+    let both = sigmoid_with(both, e);
     let (mut first, mut second) = (Lanes::<N>::splat(0.0), Lanes::<N>::splat(0.0));
     first.0.copy_from_slice(&both.0[..N]);
     second.0.copy_from_slice(&both.0[N..]);
@@ -225,13 +228,16 @@ fn sigmoid_pair<const N: usize, const N2: usize>(a: Lanes<N>, b: Lanes<N>) -> [L
 /// [`sigmoid_pair`] for `G` blocks, as one block of `NG = G N` lanes.
 #[allow(clippy::needless_range_loop)] // as in `fly`
 #[inline(always)]
-fn sigmoid_group<const N: usize, const NG: usize, const G: usize>(blocks: &[Lanes<N>; G]) -> [Lanes<N>; G] {
+fn sigmoid_group<const N: usize, const NG: usize, const G: usize>(
+    blocks: &[Lanes<N>; G],
+    e: Exponential,
+) -> [Lanes<N>; G] {
     assert_eq!(NG, G * N, "a group is G blocks wide");
     let mut all = Lanes::<NG>::splat(0.0);
     for i in 0..G {
         all.0[i * N..(i + 1) * N].copy_from_slice(&blocks[i].0);
     }
-    let all = sigmoid(all);
+    let all = sigmoid_with(all, e);
     let mut out = *blocks;
     for i in 0..G {
         out[i].0.copy_from_slice(&all.0[i * N..(i + 1) * N]);

@@ -25,6 +25,7 @@ use super::sensors::SensorSettings;
 use super::task::Task;
 use super::trial::PsaSettings;
 use crate::network::Network;
+use crate::numeric::Exponential;
 
 /// The `format` field of every network file.
 pub const FORMAT: &str = "psa-esp-network";
@@ -184,6 +185,15 @@ impl NetworkFile {
                 return Err(fail(format!("unknown version {v}; this build reads version {VERSION}")));
             }
             None => return Err(fail("no numeric \"version\" field".into())),
+        }
+        let mut value = value;
+        if let Some(problem) = value.get_mut("problem").and_then(|p| p.as_object_mut()) {
+            // Files from before the setting existed were evolved with the
+            // accurate exponential (a problem without the key would get
+            // today's default).
+            problem
+                .entry("exponential")
+                .or_insert_with(|| Exponential::Accurate.name().into());
         }
         let file: NetworkFile = serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;
         if file.activation != ACTIVATION {

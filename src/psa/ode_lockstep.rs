@@ -178,7 +178,7 @@ fn fly_steps<const NOISY: bool>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &m
             if NOISY {
                 s.noise.perturb_inputs(&mut inputs, &mut lane.noise);
             }
-            lane.network.activate(&inputs, out);
+            lane.network.activate_with(s.exponential, &inputs, out);
             if NOISY {
                 s.noise.perturb_outputs(out, &mut lane.noise);
             }

@@ -10,7 +10,7 @@ use super::sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
 use super::task::{Target, Task, TaskSettings};
 use super::{BodySettings, THRUSTER_COUNT};
 use crate::network::Network;
-use crate::numeric::{clamp_unit, NoiseSource};
+use crate::numeric::{clamp_unit, Exponential, NoiseSource};
 use crate::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, PhysicsError, StepSettings};
 use crate::rng::Stream;
 
@@ -41,6 +41,11 @@ pub struct PsaSettings {
     pub trials: usize,
     /// Random initial conditions (tasks 1 and 3). `[paper]` false
     pub random_init: bool,
+    /// The polynomial of the logistic units' exponential: `fast` (relative
+    /// error 2.2e-10) or `accurate` (within two ulps; the definition of
+    /// builds before 2026-11-26, which repeats their results bit for bit).
+    /// `[chosen]` fast
+    pub exponential: Exponential,
     /// The body.
     pub body: BodySettings,
     /// The simulation.
@@ -62,6 +67,7 @@ impl Default for PsaSettings {
             steps: 500,
             trials: 1,
             random_init: false,
+            exponential: Exponential::default(),
             body: BodySettings::default(),
             physics: StepSettings::default(),
             sensors: SensorSettings::default(),
@@ -270,7 +276,7 @@ fn fly_steps<const NOISY: bool>(
         if NOISY {
             s.noise.perturb_inputs(&mut inputs, noise);
         }
-        network.activate(&inputs, &mut outputs);
+        network.activate_with(s.exponential, &inputs, &mut outputs);
         if NOISY {
             s.noise.perturb_outputs(&mut outputs, noise);
         }

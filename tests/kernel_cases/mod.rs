@@ -3,6 +3,7 @@
 #![allow(dead_code)] // each test file uses its own share
 
 use psa_esp::network::Network;
+use psa_esp::numeric::Exponential;
 use psa_esp::physics::BackendKind;
 use psa_esp::psa::cuda::{evaluate_with, TrialBatch, TrialPoints};
 use psa_esp::psa::{FitnessKind, NoiseSettings, PsaError, PsaSettings, Task, TrialRunner};
@@ -88,9 +89,9 @@ pub fn assert_bit_identical(scalar: &[f64], other: &[f64], what: &str) {
 
 /// Asserts that the `cuda` trial kernel, its trials flown by `fly` (the
 /// host build or a GPU), gives the scalar path's fitness bit for bit on
-/// 1,700 random networks: 400 per task clean, 200 per task on tasks 1 and
-/// 3 with noise on inputs and outputs, random starts and 3 trials, and 100
-/// with the original fitness.
+/// 2,100 random networks: 400 per task clean, 200 per task on tasks 1 and
+/// 3 with noise on inputs and outputs, random starts and 3 trials, 100
+/// with the original fitness, and 400 with the accurate exponential.
 pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Result<TrialPoints, PsaError>) {
     let kernel = |settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>| {
         let networks: Vec<Network> = seeds.clone().map(random_network).collect();
@@ -113,4 +114,9 @@ pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Re
         check(&noisy, task, 9500..9700, &format!("noisy task {task}"));
     }
     check(&original_fitness_settings(), Task::Turn, 9800..9900, "original fitness");
+    let accurate = PsaSettings {
+        exponential: Exponential::Accurate,
+        ..clean
+    };
+    check(&accurate, Task::StopAtPosition, 9000..9400, "accurate exponential");
 }

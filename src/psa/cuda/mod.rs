@@ -47,12 +47,16 @@ pub struct KernelParams {
     inv_mass: f64,
     inv_inertia_z: f64,
     dt: f64,
+    exp_q: [f64; 10],
+    ln2_parts: [f64; 2],
     force_support: [i32; THRUSTER_COUNT],
     arm_support: [i32; THRUSTER_COUNT],
     steps: i32,
     noisy: i32,
     incremental: i32,
     signed_slowing: i32,
+    exp_terms: i32,
+    ln2_terms: i32,
 }
 
 /// One trial: `PsaTrial` of `trial.cu`, field for field.
@@ -90,6 +94,14 @@ pub struct TrialPoints {
     pub points: Vec<f64>,
     /// 1 where the flight ended finite, 0 where not.
     pub finite: Vec<i32>,
+}
+
+/// `values` at the front of an array of `M` (zeros after): a polynomial
+/// or ln 2's parts for the kernel, which reads as many as it is told.
+fn padded<const M: usize>(values: &[f64]) -> [f64; M] {
+    let mut array = [0.0; M];
+    array[..values.len()].copy_from_slice(values);
+    array
 }
 
 impl KernelParams {
@@ -130,6 +142,10 @@ impl KernelParams {
             noisy: settings.noise.is_active().into(),
             incremental: (f.kind == FitnessKind::Incremental).into(),
             signed_slowing: (f.slowing == SlowingRule::Signed).into(),
+            exp_q: padded(settings.exponential.coefficients()),
+            ln2_parts: padded(settings.exponential.ln2_parts()),
+            exp_terms: settings.exponential.coefficients().len() as i32,
+            ln2_terms: settings.exponential.ln2_parts().len() as i32,
         })
     }
 }

@@ -54,12 +54,16 @@ typedef struct {
     double force[PSA_THRUSTERS][2];
     double arm[PSA_THRUSTERS][2];
     double inv_mass, inv_inertia_z, dt;
+    double exp_q[10];    /* the exponential's q, highest first: exp_terms of them */
+    double ln2_parts[2]; /* ln 2 in the parts its argument reduction subtracts: ln2_terms of them */
     int force_support[PSA_THRUSTERS];
     int arm_support[PSA_THRUSTERS];
     int steps;
     int noisy;        /* any noise configured (the batched kernel's NOISY) */
     int incremental;  /* fitness: 1 incremental, 0 original */
     int signed_slowing;
+    int exp_terms;
+    int ln2_terms;
 } PsaParams;
 
 /* One trial's start and target; the Rust side is `cuda::KernelTrial` (#[repr(C)]). */
@@ -87,11 +91,6 @@ typedef struct {
 #define PSA_ONE_BITS 0x3FF0000000000000ULL
 #define PSA_MANTISSA_BITS 0x000FFFFFFFFFFFFFULL
 
-PSA_CONST double PSA_EXP_Q[10] = {
-    2.5100375832561234e-8, 2.7620075879983367e-7, 2.7557268480310024e-6, 2.4801521322368692e-5,
-    1.9841269863040545e-4, 1.3888888917196719e-3, 8.333333333330065e-3,  4.1666666666624164e-2,
-    1.6666666666666669e-1, 5.000000000000001e-1,
-};
 PSA_CONST double PSA_LN_R[7] = {
     1.4798198605116586e-1, 1.5313837699209373e-1, 1.818357216161805e-1, 2.2222198432149784e-1,
     2.857142874366239e-1,  3.999999999940942e-1,  6.666666666666735e-1,
@@ -125,18 +124,19 @@ PSA_FN double psa_exp2_int(double k) {
     return PSA_FROM_BITS((shifted - PSA_BITS(PSA_TWO_52)) << 52);
 }
 
-/* esp_neuroevolution::math::exp */
-PSA_FN double psa_exp(double x) {
+/* esp_neuroevolution::math::exp_with, its polynomial and ln 2's parts from the settings */
+PSA_FN double psa_exp(const PsaParams *p, double x) {
     if (x < -PSA_EXP_LIMIT) x = -PSA_EXP_LIMIT;
     if (PSA_EXP_LIMIT < x) x = PSA_EXP_LIMIT;
     double k = fma(x, PSA_LOG2_E, PSA_ROUNDER) - PSA_ROUNDER;
-    double r = fma(k, -PSA_LN2_LO, fma(k, -PSA_LN2_HI, x));
-    double e_r = 1.0 + fma(r * r, psa_horner(r, PSA_EXP_Q, 10), r);
+    double r = x;
+    for (int i = 0; i < p->ln2_terms; i++) r = fma(k, -p->ln2_parts[i], r);
+    double e_r = 1.0 + fma(r * r, psa_horner(r, p->exp_q, p->exp_terms), r);
     return e_r * psa_exp2_int(k);
 }
 
-/* esp_neuroevolution::math::sigmoid */
-PSA_FN double psa_sigmoid(double x) { return 1.0 / (1.0 + psa_exp(-x)); }
+/* esp_neuroevolution::math::sigmoid_with */
+PSA_FN double psa_sigmoid(const PsaParams *p, double x) { return 1.0 / (1.0 + psa_exp(p, -x)); }
 
 /* numeric::math::ln, with Real::split_exponent of numeric/mod.rs */
 PSA_FN double psa_ln(double x) {
@@ -269,10 +269,10 @@ PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial 
             const double *w = genes + k * PSA_GENES;
             double activation = w[0] * inputs[0];
             for (int i = 1; i < PSA_INPUTS; i++) activation = fma(w[i], inputs[i], activation);
-            double h = psa_sigmoid(activation);
+            double h = psa_sigmoid(p, activation);
             for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = fma(h, w[PSA_INPUTS + o], out[o]);
         }
-        for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_sigmoid(out[o]);
+        for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_sigmoid(p, out[o]);
         if (p->noisy && p->output_sd > 0.0) psa_add_scaled(noise, out, PSA_THRUSTERS, p->output_sd);
         for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_clamp_unit(out[o]);
 
