@@ -261,8 +261,9 @@ fn a_tiny_grid_reports_every_table_and_figure() {
         .unwrap()
         .map(|e| e.unwrap().path())
         .collect();
-    // Figure 4 and one curve per configuration, each as SVG and PNG.
-    assert_eq!(figures.len(), 2 * 10, "{figures:?}");
+    // Figure 4 and one curve per configuration of the paper (gomez is not
+    // one), each as SVG and PNG.
+    assert_eq!(figures.len(), 2 * 9, "{figures:?}");
     for f in figures.iter().filter(|f| f.extension().unwrap() == "png") {
         assert!(std::fs::read(f).unwrap().starts_with(b"\x89PNG"), "{}", f.display());
         let name = f.file_name().unwrap().to_str().unwrap();

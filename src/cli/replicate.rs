@@ -39,8 +39,10 @@ pub struct GridArgs {
     /// (30 seeds, 2000 generations, 500-trial robustness, native backend).
     #[arg(long, value_enum, default_value_t = GridPreset::Quick)]
     pub preset: GridPreset,
-    /// Configurations, comma-separated (default: all of baseline, systematic,
-    /// max-credit, lesion-off, erase-best, hill-climb, gomez, input-noise, random-init).
+    /// Configurations, comma-separated (default: the paper's baseline,
+    /// systematic, max-credit, lesion-off, erase-best, hill-climb,
+    /// input-noise, random-init; also gomez, Gomez's ESP, which the paper
+    /// did not run).
     #[arg(long, value_delimiter = ',')]
     pub configs: Option<Vec<GridConfig>>,
     /// Tasks, comma-separated (default: 1,2,3).

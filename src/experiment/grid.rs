@@ -108,7 +108,7 @@ impl GridSpec {
             format: GRID_FORMAT.into(),
             version: GRID_VERSION,
             preset,
-            configs: GridConfig::ALL.to_vec(),
+            configs: GridConfig::PAPER.to_vec(),
             tasks: Task::ALL.to_vec(),
             seeds,
             generations,
