@@ -165,6 +165,11 @@ fn a_grid_in_lockstep_writes_the_files_of_run_by_run_byte_for_byte() {
     );
     assert_eq!(summaries(&apart), summaries(&together));
     assert_eq!(summaries(&apart).len(), 10);
+    // Gomez's ESP, not in the paper, gets its table when the grid runs it.
+    let o = psa_esp(&["report", apart.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(apart.join("report.md")).unwrap();
+    assert!(md.contains("### Gomez's ESP"), "{md}");
 }
 
 #[test]
@@ -255,6 +260,8 @@ fn a_tiny_grid_reports_every_table_and_figure() {
         assert!(md.contains(needle), "report lacks {needle:?}");
     }
     assert!(!md.contains("NaN"), "{md}");
+    // The default grid is the paper's: no table for Gomez's ESP.
+    assert!(!md.contains("Gomez's ESP"), "{md}");
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
     assert!(report.is_object());
     let figures: Vec<_> = std::fs::read_dir(dir.join("figures"))

@@ -121,7 +121,8 @@ pub struct Report {
     pub missing: Vec<MissingCell>,
     /// Damaged or foreign run folders (not counted).
     pub problems: Vec<Problem>,
-    /// Tables 1, 4, 5, 6, 7, Gomez's ESP, then 2 and 3.
+    /// Tables 1, 4, 5, 6, 7, Gomez's ESP (when the grid runs it), then 2
+    /// and 3.
     pub tables: Vec<Table>,
     /// Burst mutations per configuration.
     pub bursts: Vec<BurstRow>,
@@ -168,8 +169,14 @@ impl Report {
     /// The report of `results` (figures not yet drawn).
     pub fn from_results(results: &GridResults) -> Report {
         let spec = &results.spec;
+        // The paper's tables always (a grid without their runs shows them
+        // missing); another configuration's only when the grid runs it.
+        let shown = |configs: &[GridConfig]| {
+            configs.iter().all(|c| GridConfig::PAPER.contains(c)) || configs.iter().any(|c| spec.configs.contains(c))
+        };
         let mut tables: Vec<Table> = CHAMPION_TABLES
             .iter()
+            .filter(|(_, _, configs)| shown(configs))
             .map(|(id, title, configs)| champion_table(results, id, title, configs))
             .collect();
         tables.extend(robustness_tables(results));
