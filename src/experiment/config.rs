@@ -244,19 +244,6 @@ pub const PAPER_NOISE_SD: f64 = 0.05;
 pub const PAPER_NOISY_TRIALS: usize = 3;
 
 impl GridConfig {
-    /// The configurations of the paper's tables, in report order: a grid's
-    /// default (`gomez`, which the paper did not run, joins when named).
-    pub const PAPER: [GridConfig; 8] = [
-        GridConfig::Preset(Preset::Baseline),
-        GridConfig::Preset(Preset::Systematic),
-        GridConfig::Preset(Preset::MaxCredit),
-        GridConfig::Preset(Preset::LesionOff),
-        GridConfig::Preset(Preset::EraseBest),
-        GridConfig::Preset(Preset::HillClimb),
-        GridConfig::InputNoise,
-        GridConfig::RandomInit,
-    ];
-
     /// Every configuration of the grid, in report order.
     pub const ALL: [GridConfig; 9] = [
         GridConfig::Preset(Preset::Baseline),
@@ -269,6 +256,12 @@ impl GridConfig {
         GridConfig::InputNoise,
         GridConfig::RandomInit,
     ];
+
+    /// Whether the paper ran it: all but `gomez`. The paper's configurations
+    /// are a grid's default; `gomez` joins when named.
+    pub fn in_paper(self) -> bool {
+        self != GridConfig::Preset(Preset::Gomez)
+    }
 
     /// The configuration's name (folder and command-line name).
     pub fn name(self) -> &'static str {

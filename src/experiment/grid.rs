@@ -108,7 +108,7 @@ impl GridSpec {
             format: GRID_FORMAT.into(),
             version: GRID_VERSION,
             preset,
-            configs: GridConfig::PAPER.to_vec(),
+            configs: GridConfig::ALL.into_iter().filter(|c| c.in_paper()).collect(),
             tasks: Task::ALL.to_vec(),
             seeds,
             generations,

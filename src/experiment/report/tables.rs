@@ -172,7 +172,7 @@ impl Report {
         // The paper's tables always (a grid without their runs shows them
         // missing); another configuration's only when the grid runs it.
         let shown = |configs: &[GridConfig]| {
-            configs.iter().all(|c| GridConfig::PAPER.contains(c)) || configs.iter().any(|c| spec.configs.contains(c))
+            configs.iter().all(|c| c.in_paper()) || configs.iter().any(|c| spec.configs.contains(c))
         };
         let mut tables: Vec<Table> = CHAMPION_TABLES
             .iter()
