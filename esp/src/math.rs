@@ -151,14 +151,6 @@ impl Exponential {
             Exponential::Accurate => &[LN2_HI, LN2_LO],
         }
     }
-
-    /// The setting's name in configuration files (`fast`, `accurate`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Exponential::Fast => "fast",
-            Exponential::Accurate => "accurate",
-        }
-    }
 }
 
 /// Horner's scheme, highest coefficient first.

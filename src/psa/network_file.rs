@@ -193,7 +193,7 @@ impl NetworkFile {
             // today's default).
             problem
                 .entry("exponential")
-                .or_insert_with(|| Exponential::Accurate.name().into());
+                .or_insert_with(|| serde_json::json!(Exponential::Accurate));
         }
         let file: NetworkFile = serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;
         if file.activation != ACTIVATION {
