@@ -86,6 +86,7 @@ fn lockstep_fitness_equals_one_world_per_network_with_noise_random_starts_and_tr
         noise: NoiseSettings {
             input_sd: 0.05,
             output_sd: 0.1,
+            ..NoiseSettings::default()
         },
         steps: 200,
         ..PsaSettings::default()

@@ -149,6 +149,7 @@ fn ode_and_native_give_the_same_fitness_with_and_without_noise() {
     let noisy = NoiseSettings {
         input_sd: 0.05,
         output_sd: 0.05,
+        ..NoiseSettings::default()
     };
     for noise in [NoiseSettings::default(), noisy] {
         for task in Task::ALL {
@@ -197,6 +198,7 @@ fn injected_noise_has_the_configured_mean_and_sd() {
     let noise = NoiseSettings {
         input_sd: 0.05,
         output_sd: 0.2,
+        ..NoiseSettings::default()
     };
     let mut source = NoiseSource::new(9);
     let n = 40_000;
@@ -252,6 +254,7 @@ fn thrust_under_output_noise_is_clamped_to_the_unit_interval() {
         noise: NoiseSettings {
             input_sd: 0.0,
             output_sd: 0.5,
+            ..NoiseSettings::default()
         },
         ..PsaSettings::default()
     };
@@ -345,6 +348,7 @@ fn random_init_is_refused_for_task_2_and_bad_settings_name_themselves() {
         noise: NoiseSettings {
             input_sd: -0.1,
             output_sd: 0.0,
+            ..NoiseSettings::default()
         },
         ..PsaSettings::default()
     };

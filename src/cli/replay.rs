@@ -136,6 +136,7 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
     if args.random_init && !task.has_random_init() {
         bail!("--random-init: task {task} has no random-initialisation variant (tasks 1 and 3 have)");
     }
+    let model = model(&args, &file)?;
     let settings = PsaSettings {
         backend: args.backend,
         trials: args.trials as usize,
@@ -143,8 +144,9 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
         noise: NoiseSettings {
             input_sd: args.input_noise,
             output_sd: args.output_noise,
+            ..model.noise
         },
-        ..model(&args, &file)?
+        ..model
     };
     let mut runner = TrialRunner::new(&settings, task)?;
     let mut rng = crate::rng::stream(args.seed, &[REPLAY_STREAM]);

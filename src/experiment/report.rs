@@ -53,7 +53,7 @@ pub enum ReportFormat {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Metric {
-    /// The champion's fitness as evolution measured it (`run.json`).
+    /// The champion's reported score: its fitness as evolution measured it (`run.json`), or its clean test under the scoring fitness where it is scored apart (`robustness.json`'s `rescored`).
     Champion,
     /// The champion flown once without noise from the standard start (`robustness.json`).
     Clean,
@@ -153,7 +153,11 @@ impl RunData {
     /// The run's value of `metric`, if it has one (random init: tasks 1 and 3).
     pub fn value(&self, metric: Metric) -> Option<f64> {
         match metric {
-            Metric::Champion => Some(self.champion),
+            Metric::Champion => Some(if self.robustness.rescored {
+                self.robustness.clean
+            } else {
+                self.champion
+            }),
             Metric::Clean => Some(self.robustness.clean),
             Metric::InputNoise => Some(self.robustness.input_noise.mean),
             Metric::RandomInit => self.robustness.random_init.map(|r| r.mean),

@@ -48,11 +48,19 @@ pub struct Robustness {
     pub input_noise: TrialSummary,
     /// From random initial conditions (tasks 1 and 3; none for task 2).
     pub random_init: Option<TrialSummary>,
+    /// Whether the champion is scored apart from its evolution: with
+    /// another fitness than evolution's (`problem.fitness.scoring`), or
+    /// re-tested by `psa-esp rescore`. Its reported score (Tables 1 and
+    /// 4-7) is then `clean`, not the run's champion fitness.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub rescored: bool,
 }
 
 /// Runs the robustness tests of `champion` on `task`. `problem` is the
-/// run's control problem; its noise, random initialisation and trials are
-/// replaced by each test's own.
+/// run's control problem, scored with its scoring fitness
+/// ([`PsaSettings::scoring_for`]); its noise, random initialisation and
+/// trials are replaced by each test's own (the input noise keeps whether it
+/// reaches the bias).
 pub fn test_robustness(
     champion: &Network,
     task: Task,
@@ -60,17 +68,21 @@ pub fn test_robustness(
     trials: usize,
     seed: u64,
 ) -> Result<Robustness> {
+    let scored = problem.scoring_for(task)?;
     let base = PsaSettings {
-        noise: NoiseSettings::default(),
+        noise: NoiseSettings {
+            on_bias: problem.noise.on_bias,
+            ..NoiseSettings::default()
+        },
         random_init: false,
         trials: 1,
-        ..problem.clone()
+        ..scored
     };
     let clean = TrialRunner::new(&base, task)?.evaluate(champion, &mut stream(seed, &[CLEAN]))?;
     let noisy = PsaSettings {
         noise: NoiseSettings {
             input_sd: PAPER_NOISE_SD,
-            output_sd: 0.0,
+            ..base.noise
         },
         trials,
         ..base.clone()
@@ -96,5 +108,6 @@ pub fn test_robustness(
         clean,
         input_noise,
         random_init,
+        rescored: problem.rescored(task),
     })
 }

@@ -27,14 +27,14 @@
 
 use multiversion::multiversion;
 
-use super::fitness::StepError;
+use super::step::{score, sense};
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use std::ops::Range;
 
 use crate::network::NetworkSet;
 use crate::numeric::{
-    clamp_unit, sigmoid_with, wrap_angle, Exponential, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words,
+    clamp_unit, sigmoid_with, Exponential, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words,
 };
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::Stream;
@@ -130,15 +130,20 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     let e = s.exponential;
     let zero = V::<N>::splat(0.0);
     let mut points = zero;
-    let mut heading_error = wrap_angle(state.heading() - target[2]);
+    let read = |state: &PlanarState<V<N>>, noise: &mut NoiseSource<Words<N>>| {
+        sense::<V<N>, NOISY>(
+            s,
+            state.position,
+            state.velocity,
+            state.heading(),
+            state.omega,
+            *target,
+            noise,
+        )
+    };
+    let mut reading = read(state, noise);
     for _ in 0..s.steps {
-        let offset = [state.position[0] - target[0], state.position[1] - target[1]];
-        let mut inputs = s
-            .sensors
-            .inputs_from(offset, state.velocity, heading_error, state.omega);
-        if NOISY {
-            s.noise.perturb_inputs(&mut inputs, noise);
-        }
+        let inputs = reading.inputs;
         let mut outputs = [zero; THRUSTER_COUNT];
         let (paired, grouped) = (G == 2, G >= THRUSTER_COUNT);
         let mut k = 0;
@@ -188,15 +193,9 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
         }
         let previous_omega = state.omega;
         flight.body.step(state, &outputs);
-        heading_error = wrap_angle(state.heading() - target[2]);
-        points = points
-            + s.fitness.points(&StepError {
-                x: state.position[0] - target[0],
-                y: state.position[1] - target[1],
-                heading: heading_error,
-                omega: state.omega,
-                previous_omega,
-            });
+        let next = read(state, noise);
+        points = points + score(s, &next, &reading, state.position, state.omega, previous_omega, *target);
+        reading = next;
     }
     let finite = |v: V<N>| v.abs().le(V::<N>::splat(f64::MAX));
     (
@@ -380,7 +379,7 @@ impl BatchRunner {
     /// name a backend other than `native` (the batched path simulates
     /// `native`'s physics only).
     pub fn new(settings: &PsaSettings, task: Task) -> Result<BatchRunner, PsaError> {
-        settings.validate_for(task)?;
+        let settings = &settings.for_task(task)?;
         if settings.backend != BackendKind::Native {
             return Err(PsaError::Setting(format!(
                 "the batched path runs the native backend only, not {}",

@@ -24,6 +24,44 @@ pub enum SlowingRule {
     Signed,
 }
 
+/// What a champion's reported score and its robustness tests are measured
+/// with (Tables 1-7), separately from the fitness evolution maximises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Scoring {
+    /// The evolution fitness itself. `[chosen]` default
+    #[default]
+    Evolution,
+    /// Høverstad's incremental fitness, whatever evolution used.
+    Incremental,
+    /// Sit's original fitness, whatever evolution used.
+    Original,
+}
+
+impl Scoring {
+    /// The fitness function a champion is scored with when evolution used `evolution`.
+    pub fn kind(self, evolution: FitnessKind) -> FitnessKind {
+        match self {
+            Scoring::Evolution => evolution,
+            Scoring::Incremental => FitnessKind::Incremental,
+            Scoring::Original => FitnessKind::Original,
+        }
+    }
+}
+
+/// Which state the fitness reads: the body's true state, or what its
+/// sensors read (the network's inputs, noise included, divided by their
+/// scales).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum FitnessState {
+    /// The true position, heading and spin. `[chosen]` default
+    #[default]
+    True,
+    /// The sensed ones: under input noise the fitness sees the noise too.
+    Sensed,
+}
+
 /// The fitness function and its windows.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -42,6 +80,11 @@ pub struct FitnessSettings {
     pub position_points: f64,
     /// Extra points for also being on heading. `[paper]` 3
     pub heading_points: f64,
+    /// What champions are scored with (Tables 1-7; per task with
+    /// `problem.taskN.scoring`). `[chosen]` evolution
+    pub scoring: Scoring,
+    /// Which state the fitness reads. `[chosen]` true
+    pub state: FitnessState,
 }
 
 impl Default for FitnessSettings {
@@ -54,6 +97,8 @@ impl Default for FitnessSettings {
             slowing: SlowingRule::Magnitude,
             position_points: 1.0,
             heading_points: 3.0,
+            scoring: Scoring::Evolution,
+            state: FitnessState::True,
         }
     }
 }

@@ -10,14 +10,15 @@ pub mod limits;
 pub mod network_file;
 pub mod ode_lockstep;
 pub mod sensors;
+pub mod step;
 pub mod task;
 pub mod trial;
 
 pub use batch::BatchRunner;
 pub use body::{BodySettings, THRUSTER_COUNT};
-pub use fitness::{FitnessKind, FitnessSettings, SlowingRule};
+pub use fitness::{FitnessKind, FitnessSettings, FitnessState, Scoring, SlowingRule};
 pub use network_file::{NetworkFile, NetworkFileError};
 pub use ode_lockstep::OdeLockstepRunner;
-pub use sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
+pub use sensors::{HeadingInput, HeadingWrap, NoiseSettings, SensorSettings, INPUT_COUNT};
 pub use task::{Target, Task, TaskSettings};
-pub use trial::{PsaError, PsaSettings, TrialRecord, TrialRunner};
+pub use trial::{PsaError, PsaSettings, TaskOverrides, TrialRecord, TrialRunner};

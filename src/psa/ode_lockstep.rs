@@ -23,12 +23,12 @@ use std::ops::Range;
 
 use multiversion::multiversion;
 
-use super::fitness::StepError;
+use super::step::{score, sense, Reading};
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{Target, Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::network::{Network, NetworkSet};
 use crate::numeric::{clamp_unit, NoiseSource};
-use crate::physics::{wrap_angle, BackendKind, OdeFleet, PlanarState};
+use crate::physics::{BackendKind, OdeFleet, PlanarState};
 use crate::rng::Stream;
 
 /// Networks flown in one ODE world at a time. From 8 bodies a world up,
@@ -55,7 +55,7 @@ impl OdeLockstepRunner {
     /// A runner for `task`; fails on invalid settings, or settings it
     /// cannot fly (see [`OdeLockstepRunner::supports`]).
     pub fn new(settings: &PsaSettings, task: Task) -> Result<OdeLockstepRunner, PsaError> {
-        settings.validate_for(task)?;
+        let settings = &settings.for_task(task)?;
         if !Self::supports(settings) {
             return Err(PsaError::Setting(format!(
                 "the ODE lockstep path runs the ode backend without QuickStep and a Plane2D joint together, not backend {} with {:?}",
@@ -123,10 +123,11 @@ impl OdeLockstepRunner {
 /// `fly_steps` in [`super::trial`] keeps between steps.
 struct Lane<'n> {
     network: &'n Network,
-    target: Target,
+    target: [f64; 3],
     noise: NoiseSource<u64>,
     state: PlanarState<f64>,
-    heading_error: f64,
+    /// What the controller read last (set when the flight starts).
+    reading: Reading<f64>,
     points: f64,
 }
 
@@ -135,12 +136,30 @@ impl<'n> Lane<'n> {
     fn new(network: &'n Network, target: Target, noise: NoiseSource<u64>, state: PlanarState<f64>) -> Lane<'n> {
         Lane {
             network,
-            heading_error: wrap_angle(state.heading() - target.heading),
-            target,
+            target: [target.x, target.y, target.heading],
             noise,
             state,
+            reading: Reading {
+                inputs: [0.0; INPUT_COUNT],
+                heading_error: 0.0,
+            },
             points: 0.0,
         }
+    }
+
+    /// What the controller reads of the lane's state now.
+    #[inline(always)]
+    fn read<const NOISY: bool>(&mut self, s: &PsaSettings) -> Reading<f64> {
+        let state = &self.state;
+        sense::<f64, NOISY>(
+            s,
+            state.position,
+            state.velocity,
+            state.heading(),
+            state.omega,
+            self.target,
+            &mut self.noise,
+        )
     }
 }
 
@@ -168,17 +187,12 @@ lockstep_loop!(fly_noisy, true);
 #[inline(always)]
 fn fly_steps<const NOISY: bool>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &mut [Lane<'_>]) -> Result<(), PsaError> {
     let mut outputs = vec![[0.0; THRUSTER_COUNT]; lanes.len()];
+    for lane in lanes.iter_mut() {
+        lane.reading = lane.read::<NOISY>(s);
+    }
     for _ in 0..s.steps {
         for (lane, out) in lanes.iter_mut().zip(&mut outputs) {
-            let (state, target) = (&lane.state, &lane.target);
-            let offset = [state.position[0] - target.x, state.position[1] - target.y];
-            let mut inputs: [f64; INPUT_COUNT] =
-                s.sensors
-                    .inputs_from(offset, state.velocity, lane.heading_error, state.omega);
-            if NOISY {
-                s.noise.perturb_inputs(&mut inputs, &mut lane.noise);
-            }
-            lane.network.activate_with(s.exponential, &inputs, out);
+            lane.network.activate_with(s.exponential, &lane.reading.inputs, out);
             if NOISY {
                 s.noise.perturb_outputs(out, &mut lane.noise);
             }
@@ -190,15 +204,18 @@ fn fly_steps<const NOISY: bool>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &m
         for (l, lane) in lanes.iter_mut().enumerate() {
             let previous_omega = lane.state.omega;
             lane.state = fleet.planar_state(l);
-            let (state, target) = (&lane.state, &lane.target);
-            lane.heading_error = wrap_angle(state.heading() - target.heading);
-            lane.points += s.fitness.points(&StepError {
-                x: state.position[0] - target.x,
-                y: state.position[1] - target.y,
-                heading: lane.heading_error,
-                omega: state.omega,
+            let next = lane.read::<NOISY>(s);
+            let state = &lane.state;
+            lane.points += score(
+                s,
+                &next,
+                &lane.reading,
+                state.position,
+                state.omega,
                 previous_omega,
-            });
+                lane.target,
+            );
+            lane.reading = next;
         }
     }
     Ok(())

@@ -12,6 +12,39 @@ use crate::physics::{wrap_angle, BodyState};
 /// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
 pub const INPUT_COUNT: usize = 7;
 
+/// What the heading input measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingInput {
+    /// The heading minus the target heading. `[chosen]` default
+    #[default]
+    Error,
+    /// The heading itself (the paper says only x and y are relative to the target).
+    Absolute,
+}
+
+/// The range the heading input is wrapped to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingWrap {
+    /// (-pi, pi]. `[chosen]` default
+    #[default]
+    Symmetric,
+    /// [0, 2 pi).
+    Positive,
+}
+
+impl HeadingWrap {
+    /// `angle` (already wrapped to (-pi, pi]) in this range.
+    #[inline(always)]
+    pub fn apply<R: Real>(self, angle: R) -> R {
+        match self {
+            HeadingWrap::Symmetric => angle,
+            HeadingWrap::Positive => R::select(angle.lt(R::splat(0.0)), angle + R::splat(std::f64::consts::TAU), angle),
+        }
+    }
+}
+
 /// Input scaling (`[chosen]` values; the paper's inputs were O(1) or larger).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -26,6 +59,10 @@ pub struct SensorSettings {
     pub angular_velocity_scale: f64,
     /// The constant bias input. `[chosen]` 1
     pub bias: f64,
+    /// What the heading input measures. `[chosen]` error
+    pub heading_input: HeadingInput,
+    /// The range the heading input is wrapped to. `[chosen]` symmetric
+    pub heading_wrap: HeadingWrap,
 }
 
 impl Default for SensorSettings {
@@ -36,32 +73,46 @@ impl Default for SensorSettings {
             heading_scale: 1.0,
             angular_velocity_scale: 1.0,
             bias: 1.0,
+            heading_input: HeadingInput::Error,
+            heading_wrap: HeadingWrap::Symmetric,
         }
     }
 }
 
 impl SensorSettings {
     /// The network inputs for `state` relative to `target`, without noise:
-    /// x, y, vx, vy, heading error wrapped to (-pi, pi], omega, bias.
+    /// x, y, vx, vy, the heading input, omega, bias.
     pub fn inputs(&self, state: &BodyState, target: &Target) -> [f64; INPUT_COUNT] {
         let heading_error = wrap_angle(state.heading - target.heading);
         self.inputs_from(
             [state.x - target.x, state.y - target.y],
             [state.vx, state.vy],
-            heading_error,
+            self.heading_reading(state.heading, heading_error),
             state.omega,
         )
     }
 
+    /// The heading input's angle before scaling: the wrapped heading error
+    /// `heading_error` (the heading minus the target's, wrapped to (-pi,
+    /// pi]) or the wrapped `heading`, in the wrap range.
+    #[inline(always)]
+    pub fn heading_reading<R: Real>(&self, heading: R, heading_error: R) -> R {
+        let angle = match self.heading_input {
+            HeadingInput::Error => heading_error,
+            HeadingInput::Absolute => crate::numeric::wrap_angle(heading),
+        };
+        self.heading_wrap.apply(angle)
+    }
+
     /// The inputs from the position relative to the target, the velocity,
-    /// the wrapped heading error and omega: the arithmetic the scalar and
-    /// the batched paths share.
+    /// the heading reading ([`SensorSettings::heading_reading`]) and omega:
+    /// the arithmetic every evaluation path shares.
     #[inline(always)]
     pub fn inputs_from<R: Real>(
         &self,
         offset: [R; 2],
         velocity: [R; 2],
-        heading_error: R,
+        heading_reading: R,
         omega: R,
     ) -> [R; INPUT_COUNT] {
         [
@@ -69,7 +120,7 @@ impl SensorSettings {
             offset[1] * R::splat(self.position_scale),
             velocity[0] * R::splat(self.velocity_scale),
             velocity[1] * R::splat(self.velocity_scale),
-            heading_error * R::splat(self.heading_scale),
+            heading_reading * R::splat(self.heading_scale),
             omega * R::splat(self.angular_velocity_scale),
             R::splat(self.bias),
         ]
@@ -87,8 +138,8 @@ impl SensorSettings {
     }
 }
 
-/// Gaussian white noise on the network's inputs (not the bias) and outputs,
-/// drawn from a [`NoiseSource`] per trial.
+/// Gaussian white noise on the network's inputs (the bias too, if
+/// `on_bias`) and outputs, drawn from a [`NoiseSource`] per trial.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseSettings {
@@ -96,6 +147,9 @@ pub struct NoiseSettings {
     pub input_sd: f64,
     /// Standard deviation of the noise on every output, before clamping to [0, 1]. `[paper]` 0
     pub output_sd: f64,
+    /// Whether the input noise reaches the bias unit too ("added to each
+    /// input neuron"; the bias is one of the seven input units). `[chosen]` false
+    pub on_bias: bool,
 }
 
 impl NoiseSettings {
@@ -120,11 +174,12 @@ impl NoiseSettings {
         }
     }
 
-    /// Adds input noise to every input but the last (the bias).
+    /// Adds input noise to every input but the last (the bias), or to
+    /// every one with `on_bias`.
     #[inline(always)]
     pub fn perturb_inputs<R: Real>(&self, inputs: &mut [R], source: &mut NoiseSource<R::Word>) {
         if self.input_sd > 0.0 {
-            let n = inputs.len() - 1;
+            let n = if self.on_bias { inputs.len() } else { inputs.len() - 1 };
             source.add_scaled(&mut inputs[..n], self.input_sd);
         }
     }

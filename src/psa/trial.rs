@@ -5,13 +5,14 @@ use multiversion::multiversion;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::fitness::{FitnessSettings, StepError};
+use super::fitness::{FitnessKind, FitnessSettings, Scoring};
 use super::sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
+use super::step::{score, sense};
 use super::task::{Target, Task, TaskSettings};
 use super::{BodySettings, THRUSTER_COUNT};
 use crate::network::Network;
 use crate::numeric::{clamp_unit, Exponential, NoiseSource};
-use crate::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, PhysicsError, StepSettings};
+use crate::physics::{create_backend, BackendKind, BodyState, PhysicsBackend, PhysicsError, StepSettings};
 use crate::rng::Stream;
 
 /// Errors of the PSA problem.
@@ -58,6 +59,38 @@ pub struct PsaSettings {
     pub tasks: TaskSettings,
     /// The fitness function.
     pub fitness: FitnessSettings,
+    /// Task 1's own trial length, fitness and scoring, where they differ.
+    #[serde(skip_serializing_if = "TaskOverrides::is_empty")]
+    pub task1: TaskOverrides,
+    /// Task 2's own trial length, fitness and scoring, where they differ.
+    #[serde(skip_serializing_if = "TaskOverrides::is_empty")]
+    pub task2: TaskOverrides,
+    /// Task 3's own trial length, fitness and scoring, where they differ.
+    #[serde(skip_serializing_if = "TaskOverrides::is_empty")]
+    pub task3: TaskOverrides,
+}
+
+/// The settings of one task that replace the problem-wide ones
+/// (`[problem.task3] steps = 2000`, `--vary problem.task3.scoring=original`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TaskOverrides {
+    /// Steps per trial (else `steps`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub steps: Option<usize>,
+    /// The fitness evolution maximises (else `fitness.kind`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fitness: Option<FitnessKind>,
+    /// What champions are scored with (else `fitness.scoring`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scoring: Option<Scoring>,
+}
+
+impl TaskOverrides {
+    /// Whether it replaces nothing.
+    pub fn is_empty(&self) -> bool {
+        *self == TaskOverrides::default()
+    }
 }
 
 impl Default for PsaSettings {
@@ -74,6 +107,9 @@ impl Default for PsaSettings {
             noise: NoiseSettings::default(),
             tasks: TaskSettings::default(),
             fitness: FitnessSettings::default(),
+            task1: TaskOverrides::default(),
+            task2: TaskOverrides::default(),
+            task3: TaskOverrides::default(),
         }
     }
 }
@@ -96,6 +132,12 @@ impl PsaSettings {
             ),
         ])
         .map_err(PsaError::Setting)?;
+        for task in Task::ALL {
+            if let Some(steps) = self.overrides(task).steps {
+                super::limits::check_as("steps", &format!("task{task}.steps"), steps as f64)
+                    .map_err(PsaError::Setting)?;
+            }
+        }
         self.sensors.validate().map_err(PsaError::Setting)?;
         self.noise.validate().map_err(PsaError::Setting)?;
         self.tasks.validate().map_err(PsaError::Setting)?;
@@ -118,6 +160,50 @@ impl PsaSettings {
             )));
         }
         Ok(())
+    }
+
+    /// The overrides of `task`.
+    pub fn overrides(&self, task: Task) -> &TaskOverrides {
+        match task {
+            Task::StopRotation => &self.task1,
+            Task::Turn => &self.task2,
+            Task::StopAtPosition => &self.task3,
+        }
+    }
+
+    /// The settings a trial of `task` flies: checked, with the task's
+    /// overrides in place of the problem-wide values (and none left).
+    pub fn for_task(&self, task: Task) -> Result<PsaSettings, PsaError> {
+        self.validate_for(task)?;
+        let overrides = *self.overrides(task);
+        let mut resolved = PsaSettings {
+            task1: TaskOverrides::default(),
+            task2: TaskOverrides::default(),
+            task3: TaskOverrides::default(),
+            ..self.clone()
+        };
+        resolved.steps = overrides.steps.unwrap_or(self.steps);
+        resolved.fitness.kind = overrides.fitness.unwrap_or(self.fitness.kind);
+        resolved.fitness.scoring = overrides.scoring.unwrap_or(self.fitness.scoring);
+        Ok(resolved)
+    }
+
+    /// The settings a champion of `task` is scored with (its reported
+    /// fitness and robustness tests): [`PsaSettings::for_task`] with the
+    /// scoring fitness as the fitness.
+    pub fn scoring_for(&self, task: Task) -> Result<PsaSettings, PsaError> {
+        let mut scored = self.for_task(task)?;
+        scored.fitness.kind = scored.fitness.scoring.kind(scored.fitness.kind);
+        scored.fitness.scoring = Scoring::Evolution;
+        Ok(scored)
+    }
+
+    /// Whether a champion of `task` is scored with another fitness than it
+    /// was evolved with.
+    pub fn rescored(&self, task: Task) -> bool {
+        let resolved_kind = self.overrides(task).fitness.unwrap_or(self.fitness.kind);
+        let scoring = self.overrides(task).scoring.unwrap_or(self.fitness.scoring);
+        scoring.kind(resolved_kind) != resolved_kind
     }
 }
 
@@ -145,17 +231,17 @@ impl TrialRunner {
     /// A runner for `task`; fails on invalid settings or when random
     /// initialisation is asked of task 2, which has no such variant.
     pub fn new(settings: &PsaSettings, task: Task) -> Result<TrialRunner, PsaError> {
-        settings.validate_for(task)?;
+        let settings = settings.for_task(task)?;
         let model = settings.body.model()?;
         let backend = create_backend(settings.backend, &model, &settings.physics)?;
         Ok(TrialRunner {
-            settings: settings.clone(),
+            settings,
             task,
             backend,
         })
     }
 
-    /// The settings this runner uses.
+    /// The settings this runner uses (the task's, [`PsaSettings::for_task`]).
     pub fn settings(&self) -> &PsaSettings {
         &self.settings
     }
@@ -266,17 +352,22 @@ fn fly_steps<const NOISY: bool>(
 ) -> Result<f64, PsaError> {
     let mut outputs = [0.0; THRUSTER_COUNT];
     let mut state = backend.planar_state();
-    let mut heading_error = wrap_angle(state.heading() - target.heading);
+    let target = [target.x, target.y, target.heading];
+    let read = |state: &crate::physics::PlanarState<f64>, noise: &mut NoiseSource<u64>| {
+        sense::<f64, NOISY>(
+            s,
+            state.position,
+            state.velocity,
+            state.heading(),
+            state.omega,
+            target,
+            noise,
+        )
+    };
+    let mut reading = read(&state, noise);
     let mut points = 0.0;
     for _ in 0..s.steps {
-        let offset = [state.position[0] - target.x, state.position[1] - target.y];
-        let mut inputs = s
-            .sensors
-            .inputs_from(offset, state.velocity, heading_error, state.omega);
-        if NOISY {
-            s.noise.perturb_inputs(&mut inputs, noise);
-        }
-        network.activate_with(s.exponential, &inputs, &mut outputs);
+        network.activate_with(s.exponential, &reading.inputs, &mut outputs);
         if NOISY {
             s.noise.perturb_outputs(&mut outputs, noise);
         }
@@ -286,14 +377,9 @@ fn fly_steps<const NOISY: bool>(
         backend.step(&outputs)?;
         let previous_omega = state.omega;
         state = backend.planar_state();
-        heading_error = wrap_angle(state.heading() - target.heading);
-        let step_points = s.fitness.points(&StepError {
-            x: state.position[0] - target.x,
-            y: state.position[1] - target.y,
-            heading: heading_error,
-            omega: state.omega,
-            previous_omega,
-        });
+        let next = read(&state, noise);
+        let step_points = score(s, &next, &reading, state.position, state.omega, previous_omega, target);
+        reading = next;
         points += step_points;
         if let Some(r) = record.as_deref_mut() {
             r.states.push(state.to_body_state());

@@ -41,6 +41,7 @@ pub fn noisy_settings() -> PsaSettings {
         noise: NoiseSettings {
             input_sd: 0.05,
             output_sd: 0.1,
+            ..NoiseSettings::default()
         },
         ..PsaSettings::default()
     })

@@ -73,6 +73,7 @@ fn write_run(dir: &Path, spec: &GridSpec, key: &RunKey) -> PathBuf {
         clean: champion,
         input_noise: TrialSummary { mean: noise, sd: 1.0 },
         random_init: random.map(|mean| TrialSummary { mean, sd: 1.0 }),
+        rescored: false,
     };
     std::fs::write(
         folder.join(FINISHED_MARKER),

@@ -21,7 +21,7 @@ mod device;
 pub use device::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME, KERNEL_SOURCE, THREADS_PER_BLOCK};
 
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
-use super::{FitnessKind, SlowingRule, Task, INPUT_COUNT, THRUSTER_COUNT};
+use super::{FitnessKind, FitnessState, HeadingInput, HeadingWrap, SlowingRule, Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::network::NetworkSet;
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::{expand, Stream};
@@ -57,6 +57,10 @@ pub struct KernelParams {
     signed_slowing: i32,
     exp_terms: i32,
     ln2_terms: i32,
+    heading_absolute: i32,
+    heading_positive: i32,
+    bias_noise: i32,
+    fitness_sensed: i32,
 }
 
 /// One trial: `PsaTrial` of `trial.cu`, field for field.
@@ -146,6 +150,10 @@ impl KernelParams {
             ln2_parts: padded(settings.exponential.ln2_parts()),
             exp_terms: settings.exponential.coefficients().len() as i32,
             ln2_terms: settings.exponential.ln2_parts().len() as i32,
+            heading_absolute: (s.heading_input == HeadingInput::Absolute).into(),
+            heading_positive: (s.heading_wrap == HeadingWrap::Positive).into(),
+            bias_noise: settings.noise.on_bias.into(),
+            fitness_sensed: (f.state == FitnessState::Sensed).into(),
         })
     }
 }
@@ -274,7 +282,7 @@ pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
     parts: &mut [KernelPart<'_, S>],
     fly: impl FnOnce(&TrialBatch) -> Result<TrialPoints, PsaError>,
 ) -> Result<Vec<Result<Vec<f64>, PsaError>>, PsaError> {
-    settings.validate_for(task)?;
+    let settings = &settings.for_task(task)?;
     if settings.backend != BackendKind::Native {
         return Err(PsaError::Setting(format!(
             "the cuda kernel repeats the native backend's physics only, not {}",

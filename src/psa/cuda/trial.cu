@@ -64,6 +64,10 @@ typedef struct {
     int signed_slowing;
     int exp_terms;
     int ln2_terms;
+    int heading_absolute; /* the heading input: 1 the heading itself, 0 the error against the target */
+    int heading_positive; /* its wrap range: 1 [0, 2 pi), 0 (-pi, pi] */
+    int bias_noise;       /* input noise on the bias too */
+    int fitness_sensed;   /* the fitness reads the sensed state (the inputs over their scales) */
 } PsaParams;
 
 /* One trial's start and target; the Rust side is `cuda::KernelTrial` (#[repr(C)]). */
@@ -242,6 +246,24 @@ PSA_FN void psa_rotate(int support, double r00, double r01, double r10, double r
     }
 }
 
+/* psa::step::sense: the inputs of a state (noisy if configured) and its true heading error. */
+PSA_FN void psa_sense(const PsaParams *p, double px, double py, double vx, double vy, double qw, double qz, double omega,
+                      double tx, double ty, double th, psa_u64 *noise, double *inputs, double *heading_error) {
+    double heading = psa_wrap_angle(2.0 * psa_atan2(qz, qw));
+    *heading_error = psa_wrap_angle(heading - th);
+    double reading = p->heading_absolute ? psa_wrap_angle(heading) : *heading_error;
+    if (p->heading_positive && reading < 0.0) reading = reading + PSA_TAU;
+    inputs[0] = (px - tx) * p->position_scale;
+    inputs[1] = (py - ty) * p->position_scale;
+    inputs[2] = vx * p->velocity_scale;
+    inputs[3] = vy * p->velocity_scale;
+    inputs[4] = reading * p->heading_scale;
+    inputs[5] = omega * p->angular_velocity_scale;
+    inputs[6] = p->bias;
+    if (p->noisy && p->input_sd > 0.0)
+        psa_add_scaled(noise, inputs, p->bias_noise ? PSA_INPUTS : PSA_INPUTS - 1, p->input_sd);
+}
+
 /* One trial: its points; *finite says whether the velocity and spin ended finite. */
 PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial *trial, int *finite) {
     double px = trial->position[0], py = trial->position[1];
@@ -252,18 +274,10 @@ PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial 
     psa_u64 noise[4] = {trial->noise_state[0], trial->noise_state[1], trial->noise_state[2], trial->noise_state[3]};
     const double *genes = weights + trial->weights;
     double points = 0.0;
-    double heading_error = psa_wrap_angle(psa_wrap_angle(2.0 * psa_atan2(qz, qw)) - th);
+    double heading_error;
+    double inputs[PSA_INPUTS];
+    psa_sense(p, px, py, vx, vy, qw, qz, omega, tx, ty, th, noise, inputs, &heading_error);
     for (int step = 0; step < p->steps; step++) {
-        double inputs[PSA_INPUTS] = {
-            (px - tx) * p->position_scale,
-            (py - ty) * p->position_scale,
-            vx * p->velocity_scale,
-            vy * p->velocity_scale,
-            heading_error * p->heading_scale,
-            omega * p->angular_velocity_scale,
-            p->bias,
-        };
-        if (p->noisy && p->input_sd > 0.0) psa_add_scaled(noise, inputs, PSA_INPUTS - 1, p->input_sd);
         double out[PSA_THRUSTERS] = {0.0, 0.0, 0.0, 0.0};
         for (int k = 0; k < trial->hidden; k++) {
             const double *w = genes + k * PSA_GENES;
@@ -305,15 +319,26 @@ PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial 
         qw = w * inv_norm;
         qz = z * inv_norm;
 
-        heading_error = psa_wrap_angle(psa_wrap_angle(2.0 * psa_atan2(qz, qw)) - th);
+        /* psa::step::score: the true state or the sensed one */
+        double next[PSA_INPUTS];
+        psa_sense(p, px, py, vx, vy, qw, qz, omega, tx, ty, th, noise, next, &heading_error);
+        double ex = px - tx, ey = py - ty, fitness_heading = heading_error, fitness_omega = omega;
+        if (p->fitness_sensed) {
+            ex = next[0] / p->position_scale;
+            ey = next[1] / p->position_scale;
+            double sensed_heading = next[4] / p->heading_scale;
+            fitness_heading = psa_wrap_angle(p->heading_absolute ? sensed_heading - th : sensed_heading);
+            fitness_omega = next[5] / p->angular_velocity_scale;
+            previous_omega = inputs[5] / p->angular_velocity_scale;
+        }
+        for (int i = 0; i < PSA_INPUTS; i++) inputs[i] = next[i];
         /* FitnessSettings::points */
-        double ex = px - tx, ey = py - ty;
         int in_box = fabs(ex) < p->box_half_width && fabs(ey) < p->box_half_width;
-        int on_heading = fabs(heading_error) < p->heading_window;
+        int on_heading = fabs(fitness_heading) < p->heading_window;
         double earned;
         if (p->incremental) {
-            double spin = fabs(omega);
-            int slowing = p->signed_slowing ? omega < previous_omega : spin < fabs(previous_omega);
+            double spin = fabs(fitness_omega);
+            int slowing = p->signed_slowing ? fitness_omega < previous_omega : spin < fabs(previous_omega);
             int spin_ok = spin < p->spin_window || slowing;
             double full = on_heading ? p->position_points + p->heading_points : p->position_points;
             earned = in_box && spin_ok ? full : 0.0;
