@@ -65,6 +65,20 @@ fn batched_fitness_equals_the_scalar_path_with_noise_random_starts_trials_and_th
     assert_bit_identical(&scalar, &batched, "original fitness");
 }
 
+#[test]
+fn batched_fitness_equals_the_scalar_path_under_every_reading_of_the_inputs_and_fitness() {
+    for (what, settings) in kernel_cases::reading_settings() {
+        for task in Task::ALL {
+            let settings = PsaSettings {
+                random_init: settings.random_init && task.has_random_init(),
+                ..settings.clone()
+            };
+            let (scalar, batched) = both_paths(&settings, task, 7300..7500, SimdLevel::detect());
+            assert_bit_identical(&scalar, &batched, &format!("{what}, task {task}"));
+        }
+    }
+}
+
 /// Networks whose thrusters turn on the last bits of one logistic unit:
 /// hidden unit 0 sees only the bias (net input `x`), unit 1 nothing (its
 /// output is 1/2 with either exponential), and output `o` gets

@@ -103,6 +103,21 @@ fn lockstep_fitness_equals_one_world_per_network_with_noise_random_starts_and_tr
 }
 
 #[test]
+fn lockstep_fitness_equals_one_world_per_network_under_every_reading_of_the_inputs_and_fitness() {
+    for (what, settings) in kernel_cases::reading_settings() {
+        for task in Task::ALL {
+            let settings = PsaSettings {
+                backend: psa_esp::physics::BackendKind::Ode,
+                random_init: settings.random_init && task.has_random_init(),
+                steps: 200,
+                ..settings.clone()
+            };
+            assert_same(&settings, task, 700..730, 8, &format!("{what}, task {task}"));
+        }
+    }
+}
+
+#[test]
 fn lockstep_fitness_equals_one_world_per_network_on_every_supported_step_setting() {
     for (stepper, plane_constraint, ode_gyroscopic) in [
         (Stepper::Quick, PlaneConstraint::None, false),

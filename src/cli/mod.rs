@@ -18,6 +18,7 @@ mod evolve;
 mod replay;
 mod replicate;
 mod report;
+mod rescore;
 mod simulate;
 mod sweep;
 
@@ -52,6 +53,8 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Compare a grid's results with the paper's tables: report.md, figures, and CSV or JSON.
     Report(report::ReportArgs),
+    /// Test a finished grid's champions again under other scoring settings, into a new grid folder (resumable).
+    Rescore(rescore::RescoreArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
     Replay(replay::ReplayArgs),
     /// Measure physics steps and network evaluations of every backend in one run.
@@ -67,6 +70,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
         Command::Replicate(args) => replicate::run(args),
         Command::Sweep(args) => sweep::run(args),
         Command::Report(args) => report::run(args),
+        Command::Rescore(args) => rescore::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
     }

@@ -157,7 +157,7 @@ fn by_name<T: Copy>(s: &str, all: &[T], name: fn(T) -> &'static str, what: &str)
 }
 
 /// Overlays `overrides` onto `base`, table by table.
-fn merge(base: &mut toml::Table, overrides: toml::Table) {
+pub(super) fn merge(base: &mut toml::Table, overrides: toml::Table) {
     for (key, value) in overrides {
         match (base.get_mut(&key), value) {
             (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),

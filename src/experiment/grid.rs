@@ -72,6 +72,11 @@ pub struct GridSpec {
     /// change (a TOML document, as `--config` files are written).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub overrides: Option<String>,
+    /// Settings laid over every run's configuration for its champion's
+    /// robustness tests and reported score only, not its evolution (a TOML
+    /// document): a grid re-scored by `psa-esp rescore`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rescoring: Option<String>,
 }
 
 /// The folder status of one run.
@@ -116,6 +121,7 @@ impl GridSpec {
             robustness_trials,
             ode_check: preset == GridPreset::Paper && backend == BackendKind::Native,
             overrides: None,
+            rescoring: None,
         }
     }
 
@@ -189,6 +195,18 @@ impl GridSpec {
         c.validate()
             .with_context(|| format!("configuration {config} with the grid's overrides"))?;
         Ok(c)
+    }
+
+    /// The configuration `config`'s champions are tested and scored with:
+    /// [`GridSpec::run_config`] with the grid's rescoring laid over it.
+    pub fn scoring_config(&self, config: GridConfig) -> Result<RunConfig> {
+        let run = self.run_config(config)?;
+        match &self.rescoring {
+            Some(text) => run
+                .with_overrides(text)
+                .with_context(|| format!("configuration {config} with the grid's rescoring")),
+            None => Ok(run),
+        }
     }
 
     /// Reads `DIR/grid.json`, checking its format and version.

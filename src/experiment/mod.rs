@@ -9,6 +9,7 @@ pub mod lockstep;
 pub mod ode_check;
 pub mod replicate;
 pub mod report;
+pub mod rescore;
 pub mod robustness;
 mod run;
 pub mod runs_table;

@@ -17,7 +17,7 @@ use super::claim::{claim, Attempt, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
 use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
 use super::lockstep::{replicate_lockstep, Executor};
 use super::ode_check::check_on_ode;
-use super::robustness::test_robustness;
+use super::robustness::{test_robustness, Robustness};
 use super::shard::Shard;
 use super::{run_evolution, EvolveOutcome, RunFiles};
 use crate::psa::NetworkFile;
@@ -200,20 +200,12 @@ pub(super) fn test_and_mark(
     mut outcome: EvolveOutcome,
 ) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
-    let config = spec.run_config(key.config)?;
-    let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
-    let robustness = test_robustness(
-        &champion,
-        key.task,
-        &config.problem,
-        spec.robustness_trials,
-        outcome.seed,
-    )?;
+    let (champion, scoring, robustness) = score_champion(&folder, spec, key, outcome.seed)?;
     if spec.ode_check {
         let check = check_on_ode(
             &champion,
             key.task,
-            &config.problem,
+            &scoring.problem,
             spec.robustness_trials,
             outcome.seed,
             &robustness,
@@ -223,10 +215,31 @@ pub(super) fn test_and_mark(
         outcome.save(&RunFiles::in_dir(&folder).summary)?;
         check.verify(&folder.display().to_string())?;
     }
-    let mut json = serde_json::to_string_pretty(&robustness)?;
-    json.push('\n');
-    crate::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())?;
+    mark_finished(&folder, &robustness)?;
     Ok(FinishedRun { key: *key, outcome })
+}
+
+/// The robustness tests of the champion in `folder` (run `key` of `spec`,
+/// run seed `seed`) under the grid's scoring configuration; returns the
+/// champion, that configuration and the results.
+pub(super) fn score_champion(
+    folder: &Path,
+    spec: &GridSpec,
+    key: &RunKey,
+    seed: u64,
+) -> Result<(crate::network::Network, super::RunConfig, Robustness)> {
+    let scoring = spec.scoring_config(key.config)?;
+    let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
+    let mut robustness = test_robustness(&champion, key.task, &scoring.problem, spec.robustness_trials, seed)?;
+    robustness.rescored |= spec.rescoring.is_some();
+    Ok((champion, scoring, robustness))
+}
+
+/// Writes `robustness.json`, the run's last file, which marks it finished.
+pub(super) fn mark_finished(folder: &Path, robustness: &Robustness) -> Result<()> {
+    let mut json = serde_json::to_string_pretty(robustness)?;
+    json.push('\n');
+    crate::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())
 }
 
 /// What became of one run this process went for.

@@ -91,3 +91,129 @@ fn sensed_error<R: Real>(s: &PsaSettings, now: &Reading<R>, before: &Reading<R>,
         previous_omega: spin(before),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::{PI, TAU};
+
+    use super::*;
+    use crate::psa::fitness::{FitnessKind, Scoring};
+    use crate::psa::sensors::{HeadingInput, HeadingWrap};
+    use crate::psa::{Task, TaskOverrides, TrialRunner};
+
+    fn clean_reading(s: &PsaSettings, heading: f64, target: [f64; 3]) -> Reading<f64> {
+        sense::<f64, false>(
+            s,
+            [0.01, -0.02],
+            [0.1, 0.0],
+            heading,
+            0.5,
+            target,
+            &mut NoiseSource::new(0),
+        )
+    }
+
+    #[test]
+    fn the_heading_input_is_the_error_or_the_heading_in_its_wrap_range() {
+        let mut s = PsaSettings::default();
+        let target = [0.0, 0.0, 1.0];
+        // The error: heading -3 against target 1 is -4, wrapped to 2 pi - 4.
+        assert_eq!(clean_reading(&s, -3.0, target).inputs[4], TAU - 4.0);
+        s.sensors.heading_input = HeadingInput::Absolute;
+        assert_eq!(clean_reading(&s, -3.0, target).inputs[4], -3.0);
+        s.sensors.heading_wrap = HeadingWrap::Positive;
+        assert_eq!(clean_reading(&s, -3.0, target).inputs[4], TAU - 3.0);
+        assert_eq!(clean_reading(&s, 0.5, target).inputs[4], 0.5);
+        s.sensors.heading_input = HeadingInput::Error;
+        // -0.5 - 1 = -1.5 lies in (-pi, 0): moved up by 2 pi.
+        assert_eq!(clean_reading(&s, -0.5, target).inputs[4], TAU - 1.5);
+        // The true heading error the fitness reads is the same in every case.
+        assert_eq!(clean_reading(&s, -0.5, target).heading_error, -1.5);
+        s.sensors.heading_scale = 2.0;
+        assert_eq!(clean_reading(&s, PI, target).inputs[4], 2.0 * (PI - 1.0));
+    }
+
+    #[test]
+    fn input_noise_reaches_the_bias_only_when_asked() {
+        let mut s = PsaSettings::default();
+        s.noise.input_sd = 0.05;
+        let read = |s: &PsaSettings| {
+            sense::<f64, true>(s, [0.0; 2], [0.0; 2], 0.0, 0.0, [0.0; 3], &mut NoiseSource::new(7)).inputs
+        };
+        let without = read(&s);
+        assert_eq!(without[6], s.sensors.bias);
+        s.noise.on_bias = true;
+        let with = read(&s);
+        assert_ne!(with[6], s.sensors.bias);
+        // The other inputs draw the same numbers either way.
+        assert_eq!(without[..6], with[..6]);
+        assert!(without[..6].iter().all(|&v| v != 0.0));
+    }
+
+    #[test]
+    fn the_sensed_fitness_reads_the_inputs_over_their_scales() {
+        let mut s = PsaSettings::default();
+        let target = [0.0, 0.0, 0.0];
+        let before = clean_reading(&s, 0.0, target);
+        // Truly on heading, in the box and spinning slower than before.
+        let mut now = clean_reading(&s, 0.0, target);
+        now.inputs[5] = 0.4;
+        let truth = score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target);
+        assert_eq!(truth, 4.0);
+        // The sensors read 0.1 rad off heading and a spin of 0.6: under
+        // the true reading nothing changes.
+        now.inputs[4] = 0.1;
+        now.inputs[5] = 0.6;
+        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 4.0);
+        s.fitness.state = FitnessState::Sensed;
+        // Sensed: off heading, and the spin (0.6 against 0.5 read before) rises.
+        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 0.0);
+        now.inputs[5] = 0.3;
+        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 1.0);
+        // Position: 10 input units a metre, so 2.5 reads 0.25 m, out of the box.
+        now.inputs[0] = 2.5;
+        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 0.0);
+        // An absolute heading input is read against the target heading.
+        s.sensors.heading_input = HeadingInput::Absolute;
+        let target = [0.0, 0.0, 3.0];
+        now.inputs[0] = 0.1;
+        now.inputs[4] = 3.01;
+        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 4.0);
+    }
+
+    #[test]
+    fn a_task_flies_its_own_steps_and_fitness_and_is_scored_with_its_scoring() {
+        let mut s = PsaSettings::default();
+        s.task3 = TaskOverrides {
+            steps: Some(2000),
+            fitness: Some(FitnessKind::Original),
+            scoring: None,
+        };
+        s.fitness.scoring = Scoring::Original;
+        let task3 = s.for_task(Task::StopAtPosition).unwrap();
+        assert_eq!((task3.steps, task3.fitness.kind), (2000, FitnessKind::Original));
+        assert!(task3.task3.is_empty());
+        assert_eq!(
+            TrialRunner::new(&s, Task::StopAtPosition).unwrap().maximum_points(),
+            2000.0
+        );
+        assert_eq!(TrialRunner::new(&s, Task::Turn).unwrap().maximum_points(), 2000.0);
+        let task1 = s.for_task(Task::StopRotation).unwrap();
+        assert_eq!((task1.steps, task1.fitness.kind), (500, FitnessKind::Incremental));
+        // Scored on the original fitness: task 1 apart, task 3 already evolved on it.
+        assert!(s.rescored(Task::StopRotation) && !s.rescored(Task::StopAtPosition));
+        assert_eq!(
+            s.scoring_for(Task::StopRotation).unwrap().fitness.kind,
+            FitnessKind::Original
+        );
+        s.task1.scoring = Some(Scoring::Evolution);
+        assert!(!s.rescored(Task::StopRotation));
+        assert_eq!(
+            s.scoring_for(Task::StopRotation).unwrap().fitness.kind,
+            FitnessKind::Incremental
+        );
+        s.task2.steps = Some(0);
+        let error = s.validate().unwrap_err().to_string();
+        assert!(error.contains("task2.steps = 0"), "{error}");
+    }
+}

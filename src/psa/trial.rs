@@ -198,6 +198,50 @@ impl PsaSettings {
         Ok(scored)
     }
 
+    /// The readings of the inputs and the fitness these settings fly, in
+    /// words, for reports: per task the fitness evolved on, the trial's
+    /// length and the fitness champions are scored on; the heading input;
+    /// the noise on the bias; the state the fitness reads.
+    pub fn describe_readings(&self) -> Vec<String> {
+        let name = |kind: FitnessKind| match kind {
+            FitnessKind::Incremental => "incremental",
+            FitnessKind::Original => "original",
+        };
+        let mut lines: Vec<String> = Task::ALL
+            .iter()
+            .filter_map(|&task| {
+                let s = self.for_task(task).ok()?;
+                Some(format!(
+                    "task {task}: evolved on the {} fitness over {} steps, scored on the {}",
+                    name(s.fitness.kind),
+                    s.steps,
+                    name(s.fitness.scoring.kind(s.fitness.kind))
+                ))
+            })
+            .collect();
+        let heading = match self.sensors.heading_input {
+            super::HeadingInput::Error => "the heading error",
+            super::HeadingInput::Absolute => "the absolute heading",
+        };
+        let range = match self.sensors.heading_wrap {
+            super::HeadingWrap::Symmetric => "(-pi, pi]",
+            super::HeadingWrap::Positive => "[0, 2 pi)",
+        };
+        lines.push(format!("heading input: {heading} in {range}"));
+        lines.push(format!(
+            "input noise on the bias: {}",
+            if self.noise.on_bias { "yes" } else { "no" }
+        ));
+        lines.push(format!(
+            "the fitness reads the {} state",
+            match self.fitness.state {
+                super::FitnessState::True => "true",
+                super::FitnessState::Sensed => "sensed",
+            }
+        ));
+        lines
+    }
+
     /// Whether a champion of `task` is scored with another fitness than it
     /// was evolved with.
     pub fn rescored(&self, task: Task) -> bool {

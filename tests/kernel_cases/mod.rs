@@ -6,7 +6,10 @@ use psa_esp::network::Network;
 use psa_esp::numeric::Exponential;
 use psa_esp::physics::BackendKind;
 use psa_esp::psa::cuda::{evaluate_with, TrialBatch, TrialPoints};
-use psa_esp::psa::{FitnessKind, NoiseSettings, PsaError, PsaSettings, Task, TrialRunner};
+use psa_esp::psa::{
+    FitnessKind, FitnessState, HeadingInput, HeadingWrap, NoiseSettings, PsaError, PsaSettings, Scoring, Task,
+    TaskOverrides, TrialRunner,
+};
 use psa_esp::rng::{stream, Stream};
 use rand::RngExt;
 
@@ -55,6 +58,33 @@ pub fn original_fitness_settings() -> PsaSettings {
     original
 }
 
+/// Every reading of the inputs and the fitness that is not the default,
+/// together: the heading input absolute and wrapped to [0, 2 pi), the
+/// fitness read from the sensed state, and task 3 evolved on the original
+/// fitness over 250 steps (task 1 scored on it, which the evaluation paths
+/// ignore); first with noise on every input, the bias included, outputs
+/// and random starts, then clean.
+pub fn reading_settings() -> [(&'static str, PsaSettings); 2] {
+    let mut readings = noisy_settings();
+    readings.noise.on_bias = true;
+    readings.sensors.heading_input = HeadingInput::Absolute;
+    readings.sensors.heading_wrap = HeadingWrap::Positive;
+    readings.fitness.state = FitnessState::Sensed;
+    readings.task3 = TaskOverrides {
+        steps: Some(250),
+        fitness: Some(FitnessKind::Original),
+        scoring: None,
+    };
+    readings.task1.scoring = Some(Scoring::Original);
+    let clean = PsaSettings {
+        noise: NoiseSettings::default(),
+        random_init: false,
+        trials: 1,
+        ..readings.clone()
+    };
+    [("every reading, noisy", readings), ("every reading, clean", clean)]
+}
+
 /// One evaluation stream per network seed.
 pub fn streams(seeds: std::ops::Range<u64>) -> Vec<Stream> {
     seeds.map(|s| stream(s, &[2])).collect()
@@ -92,7 +122,8 @@ pub fn assert_bit_identical(scalar: &[f64], other: &[f64], what: &str) {
 /// host build or a GPU), gives the scalar path's fitness bit for bit on
 /// 2,100 random networks: 400 per task clean, 200 per task on tasks 1 and
 /// 3 with noise on inputs and outputs, random starts and 3 trials, 100
-/// with the original fitness, and 400 with the accurate exponential.
+/// with the original fitness, 400 with the accurate exponential, and 150
+/// per task under every other reading ([`reading_settings`]).
 pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Result<TrialPoints, PsaError>) {
     let kernel = |settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>| {
         let networks: Vec<Network> = seeds.clone().map(random_network).collect();
@@ -120,4 +151,13 @@ pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Re
         ..clean
     };
     check(&accurate, Task::StopAtPosition, 9000..9400, "accurate exponential");
+    for (what, settings) in reading_settings() {
+        for task in Task::ALL {
+            let settings = PsaSettings {
+                random_init: settings.random_init && task.has_random_init(),
+                ..settings.clone()
+            };
+            check(&settings, task, 9400..9550, &format!("{what}, task {task}"));
+        }
+    }
 }

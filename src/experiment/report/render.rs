@@ -155,6 +155,23 @@ fn grid_section(md: &mut String, report: &Report) {
     for (k, v) in rows {
         let _ = writeln!(md, "| {k} | {v} |");
     }
+    if let Some(config) = g.configs.first() {
+        if let Ok(run) = g.run_config(*config) {
+            let _ = writeln!(md, "| readings | {} |", run.problem.describe_readings().join("; "));
+        }
+    }
+    if let Some(rescoring) = &g.rescoring {
+        let settings: Vec<String> = rescoring
+            .lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| format!("`{l}`"))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| re-scored | champions tested again by `psa-esp rescore` with {} |",
+            settings.join(" ")
+        );
+    }
     for b in &report.builds {
         let _ = writeln!(
             md,
