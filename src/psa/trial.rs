@@ -200,9 +200,10 @@ impl PsaSettings {
 
     /// The readings of the inputs and the fitness these settings fly, in
     /// words, for reports: per task the fitness evolved on, the trial's
-    /// length and the fitness champions are scored on; the heading input;
-    /// the noise on the bias; the state the fitness reads.
-    pub fn describe_readings(&self) -> Vec<String> {
+    /// length and the fitness champions are scored on under `scoring` (these
+    /// settings, or the ones a re-scored grid tests with); the heading
+    /// input; the noise on the bias; the state the fitness reads.
+    pub fn describe_readings(&self, scoring: &PsaSettings) -> Vec<String> {
         let name = |kind: FitnessKind| match kind {
             FitnessKind::Incremental => "incremental",
             FitnessKind::Original => "original",
@@ -211,11 +212,12 @@ impl PsaSettings {
             .iter()
             .filter_map(|&task| {
                 let s = self.for_task(task).ok()?;
+                let scored = scoring.scoring_for(task).ok()?;
                 Some(format!(
                     "task {task}: evolved on the {} fitness over {} steps, scored on the {}",
                     name(s.fitness.kind),
                     s.steps,
-                    name(s.fitness.scoring.kind(s.fitness.kind))
+                    name(scored.fitness.kind)
                 ))
             })
             .collect();

@@ -156,8 +156,9 @@ fn grid_section(md: &mut String, report: &Report) {
         let _ = writeln!(md, "| {k} | {v} |");
     }
     if let Some(config) = g.configs.first() {
-        if let Ok(run) = g.run_config(*config) {
-            let _ = writeln!(md, "| readings | {} |", run.problem.describe_readings().join("; "));
+        if let (Ok(run), Ok(scoring)) = (g.run_config(*config), g.scoring_config(*config)) {
+            let readings = run.problem.describe_readings(&scoring.problem);
+            let _ = writeln!(md, "| readings | {} |", readings.join("; "));
         }
     }
     if let Some(rescoring) = &g.rescoring {
