@@ -70,12 +70,13 @@ fn doing_nothing_scores_under_1_percent_on_task_2_and_a_few_on_tasks_1_and_3() {
     }
 }
 
-#[test]
-fn the_previous_defaults_file_repeats_the_earlier_records_byte_for_byte() {
+/// Asserts that `config` laid over each of `presets` repeats the records
+/// in `tests/golden/GOLDEN/PRESET-tTASK.csv` on every task, byte for byte
+/// (seed 7, 120 generations, native).
+fn assert_repeats_the_golden_records(config: &str, golden: &str, presets: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
-    let config = repo("configs/previous-defaults.toml");
-    // Recorded by the build before the fit (6631aa9): seed 7, 120 generations, native.
-    for preset in ["baseline", "max-credit", "hill-climb"] {
+    let config = repo(config);
+    for preset in presets {
         for task in ["1", "2", "3"] {
             let out = dir.path().join(format!("{preset}-t{task}"));
             ok(&psa_esp(&[
@@ -95,14 +96,34 @@ fn the_previous_defaults_file_repeats_the_earlier_records_byte_for_byte() {
                 "--out",
                 out.to_str().unwrap(),
             ]));
-            let golden = std::fs::read(repo(&format!("tests/golden/previous-defaults/{preset}-t{task}.csv"))).unwrap();
+            let recorded = std::fs::read(repo(&format!("tests/golden/{golden}/{preset}-t{task}.csv"))).unwrap();
             let records = std::fs::read(out.join("records.csv")).unwrap();
             assert!(
-                records == golden,
-                "{preset} task {task}: records.csv differs from the earlier build's"
+                records == recorded,
+                "{preset} task {task}: records.csv differs from the one recorded in tests/golden/{golden}"
             );
         }
     }
+}
+
+#[test]
+fn the_previous_defaults_file_repeats_the_earlier_records_byte_for_byte() {
+    // Recorded by the build before the fit (6631aa9).
+    assert_repeats_the_golden_records(
+        "configs/previous-defaults.toml",
+        "previous-defaults",
+        &["baseline", "max-credit", "hill-climb"],
+    );
+}
+
+#[test]
+fn the_fitted_incremental_file_repeats_the_records_of_the_model_before_the_readings_byte_for_byte() {
+    // Recorded by build bf1d0de, whose defaults the file pins.
+    assert_repeats_the_golden_records(
+        "configs/fitted-incremental.toml",
+        "fitted-incremental",
+        &["baseline", "max-credit"],
+    );
 }
 
 #[test]
