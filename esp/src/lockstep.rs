@@ -201,10 +201,12 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
             .collect();
         let mut owners = Vec::new();
         let mut jobs = Vec::new();
+        let mut tickets = vec![None; live.len()];
         for (i, asked) in asked.iter().enumerate() {
             match asked {
                 Some(Ok(Some(asked))) => {
                     owners.push(i);
+                    tickets[i] = Some(asked.ticket());
                     jobs.push(Job {
                         evaluator: evaluators[i],
                         networks: asked,
@@ -228,11 +230,11 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
         }
         let told: Vec<Option<RunError>> = runs
             .par_iter_mut()
-            .zip(fitness)
+            .zip(fitness.into_par_iter().zip(tickets))
             .enumerate()
-            .map(|(i, (run, fitness))| {
-                let fitness = fitness?;
-                let result = fitness.and_then(|fitness| run.tell(&fitness).map(|record| record.cloned()));
+            .map(|(i, (run, (fitness, ticket)))| {
+                let (fitness, ticket) = (fitness?, ticket?);
+                let result = fitness.and_then(|fitness| run.tell(ticket, &fitness).map(|record| record.cloned()));
                 match result {
                     Ok(Some(record)) => {
                         if on_record(i, &record) == Control::Stop {
