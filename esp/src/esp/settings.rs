@@ -131,10 +131,11 @@ pub struct EspSettings {
     /// any rise counts). Bounds: finite and >= 0.
     ///
     /// Where fitness creeps up by tiny amounts a run under the phase best
-    /// rule never bursts: XOR with `4 - squared error`, small settings,
-    /// stays 500 generations at 3.75 with no burst mutation, as each
-    /// generation's best rises by a hair. A minimum improvement (say 1e-3
-    /// of the fitness range) lets such a run burst.
+    /// rule may never burst: XOR scored `4 - squared error` with 2 hidden
+    /// units of 20 neurons (seed 2) stays near 3.5 for 500 generations
+    /// with no burst mutation, as each generation's best rises by a hair;
+    /// with a minimum improvement of 0.01 it bursts 23 times (a test in
+    /// `tests/library.rs`).
     #[serde(skip_serializing_if = "is_zero")]
     pub stagnation_min_improvement: f64,
     /// Scale of the Cauchy noise of burst mutation, on every gene. Default
