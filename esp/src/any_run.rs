@@ -45,6 +45,17 @@ impl AnyRun {
         }
     }
 
+    /// Whether `other` is a run of the same search (kind, settings, seed
+    /// and stop conditions): what a restored run is checked against before
+    /// it stands in for a new one.
+    pub fn same_search(&self, other: &AnyRun) -> bool {
+        match (self, other) {
+            (AnyRun::Esp(a), AnyRun::Esp(b)) => a.esp() == b.esp(),
+            (AnyRun::HillClimb(a), AnyRun::HillClimb(b)) => a.hill_climb() == b.hill_climb(),
+            _ => false,
+        }
+    }
+
     /// The result of the ended run; [`RunError::NotEnded`] before.
     pub fn into_result(self) -> Result<RunResult, RunError> {
         match self {

@@ -190,10 +190,29 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
     evaluators: &[&E],
     on_record: impl Fn(usize, &GenerationRecord) -> Control + Sync,
 ) -> Vec<Option<RunError>> {
+    lockstep_with(runs, evaluators, on_record, |_, _| {})
+}
+
+/// [`lockstep`], calling `after_round(round, runs)` after every round
+/// (from 1) with all the runs as they stand: the place to save them
+/// (serde: [`AnyRun`](crate::AnyRun), [`EspRun`](crate::EspRun)), so that
+/// runs killed with their process resume, restored, where the last save
+/// left them, each still bit-identical to its own run.
+///
+/// # Panics
+/// If `evaluators` and `runs` differ in length.
+pub fn lockstep_with<R: AskTell + Send, E: Evaluator>(
+    runs: &mut [R],
+    evaluators: &[&E],
+    on_record: impl Fn(usize, &GenerationRecord) -> Control + Sync,
+    mut after_round: impl FnMut(usize, &[R]),
+) -> Vec<Option<RunError>> {
     assert_eq!(runs.len(), evaluators.len(), "one evaluator per run");
     let mut failed: Vec<Option<RunError>> = runs.iter().map(|_| None).collect();
     let mut live: Vec<bool> = vec![true; runs.len()];
+    let mut round = 0;
     while live.iter().any(|&l| l) {
+        round += 1;
         let asked: Vec<_> = runs
             .par_iter_mut()
             .zip(&live)
@@ -253,6 +272,7 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
                 live[i] = false;
             }
         }
+        after_round(round, runs);
     }
     failed
 }

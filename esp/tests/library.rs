@@ -92,7 +92,10 @@ fn an_esp_run_saved_and_restored_anywhere_ends_as_one_never_stopped() {
     for settings in [EspSettings::gomez(), EspSettings::hoverstad()] {
         let esp = Esp::new(small(settings), 4).unwrap();
         let whole = esp.run(&evaluator, |_| {}).unwrap();
-        assert!(whole.records.iter().any(|r| r.lesion.is_some()), "lesion tests happened");
+        assert!(
+            whole.records.iter().any(|r| r.lesion.is_some()),
+            "lesion tests happened"
+        );
         // Saved after every tell (between a generation's evaluation and its
         // lesion test too), and after every third.
         for (every, offset) in [(1, 0), (3, 1)] {
@@ -148,7 +151,10 @@ fn a_saved_run_that_does_not_fit_its_settings_is_refused_and_old_tickets_are_for
     let mut invalid = saved;
     invalid["search"]["settings"]["mutation_rate"] = 2.0.into();
     let error = serde_json::from_value::<esp_neuroevolution::EspRun>(invalid).unwrap_err();
-    assert!(error.to_string().contains("esp.mutation_rate must be a probability"), "{error}");
+    assert!(
+        error.to_string().contains("esp.mutation_rate must be a probability"),
+        "{error}"
+    );
     // A network checks its weights and shape as it is read.
     let network = Network::from_genes(2, 1, vec![0.5, -1.0, 2.0]).unwrap();
     let json = serde_json::to_string(&network).unwrap();
@@ -176,10 +182,17 @@ fn adding_a_constant_to_the_fitness_changes_no_run_whatever_its_sign() {
         let positive = esp.run(&xor(4.0), |_| {}).unwrap();
         for offset in [0.0, -16.0, 1024.0] {
             let shifted = esp.run(&xor(offset), |_| {}).unwrap();
-            assert_eq!(shifted.champion.network, positive.champion.network, "{sampling:?} {offset}");
+            assert_eq!(
+                shifted.champion.network, positive.champion.network,
+                "{sampling:?} {offset}"
+            );
             assert_eq!(shifted.champion.evaluation, positive.champion.evaluation);
             for (a, b) in shifted.records.iter().zip(&positive.records) {
-                assert_eq!((a.max - offset, a.bursts), (b.max - 4.0, b.bursts), "{sampling:?} {offset}");
+                assert_eq!(
+                    (a.max - offset, a.bursts),
+                    (b.max - 4.0, b.bursts),
+                    "{sampling:?} {offset}"
+                );
             }
         }
     }
@@ -196,7 +209,10 @@ fn careless_inputs_are_typed_errors() {
         };
         let error = esp.clone().stop_at(stop).run(&evaluator, |_| {}).unwrap_err();
         assert!(
-            matches!(error, RunError::Settings(SettingsError::NotFinite { name: "stop.goal", .. })),
+            matches!(
+                error,
+                RunError::Settings(SettingsError::NotFinite { name: "stop.goal", .. })
+            ),
             "{error:?}"
         );
         let hill_climb = HillClimb::new(HillClimbSettings::default(), 1).unwrap().stop_at(stop);
@@ -234,7 +250,10 @@ fn careless_inputs_are_typed_errors() {
         1,
     )
     .unwrap_err();
-    assert_eq!(error.to_string(), "esp.stagnation_min_improvement must be finite and >= 0, got -1");
+    assert_eq!(
+        error.to_string(),
+        "esp.stagnation_min_improvement must be finite and >= 0, got -1"
+    );
 }
 
 #[test]
@@ -259,4 +278,54 @@ fn a_minimum_improvement_lets_a_creeping_run_burst() {
     };
     let bursting = Esp::new(with_minimum, 2).unwrap().run(&xor, |_| {}).unwrap();
     assert!(bursting.records.last().unwrap().bursts >= 10);
+}
+
+#[test]
+fn runs_in_lockstep_saved_after_a_round_resume_to_their_own_runs() {
+    use esp_neuroevolution::lockstep::lockstep_with;
+    use esp_neuroevolution::Control;
+    let evaluator = noisy();
+    let esp = Esp::new(small(EspSettings::hoverstad()), 5).unwrap();
+    let hill_climb = HillClimb::new(
+        HillClimbSettings {
+            hidden: 2,
+            candidates: 6,
+            cycles: 30,
+            elitist: true,
+            ..HillClimbSettings::default()
+        },
+        6,
+    )
+    .unwrap();
+    let alone = [
+        esp.run(&evaluator, |_| {}).unwrap(),
+        hill_climb.run(&evaluator, |_| {}).unwrap(),
+    ];
+    let start = || -> Vec<AnyRun> { vec![esp.start(2, 1).unwrap().into(), hill_climb.start(2, 1).unwrap().into()] };
+    let evaluators = [&evaluator, &evaluator];
+    // Saved after round 7, as a killed process would have left them.
+    let mut saved = String::new();
+    let mut runs = start();
+    let errors = lockstep_with(
+        &mut runs,
+        &evaluators,
+        |_, _| Control::Continue,
+        |round, runs| {
+            if round == 7 {
+                saved = serde_json::to_string(runs).unwrap();
+            }
+        },
+    );
+    assert!(errors.iter().all(Option::is_none));
+    let mut restored: Vec<AnyRun> = serde_json::from_str(&saved).unwrap();
+    assert!(restored.iter().zip(start()).all(|(a, b)| a.same_search(&b)));
+    assert!(restored
+        .iter()
+        .all(|run| !run.records().is_empty() && run.ending().is_none()));
+    let errors = lockstep_with(&mut restored, &evaluators, |_, _| Control::Continue, |_, _| {});
+    assert!(errors.iter().all(Option::is_none));
+    for ((resumed, uninterrupted), alone) in restored.into_iter().zip(runs).zip(&alone) {
+        assert_eq!(bits(&resumed.into_result().unwrap()), bits(alone));
+        assert_eq!(bits(&uninterrupted.into_result().unwrap()), bits(alone));
+    }
 }
