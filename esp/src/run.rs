@@ -80,15 +80,23 @@ fn new_run_id() -> u64 {
 }
 
 /// A run of search `A` under way, as a state machine driven by ask and
-/// tell: its whole state, which serde saves and restores (a restored run
-/// goes on as the saved one would have, bit for bit).
+/// tell: its whole state ([`Saved`]), which serde saves and restores (a
+/// restored run goes on as the saved one would have, bit for bit), and its
+/// identity in its tickets (a restored run has a new one).
+#[derive(Debug, Clone)]
+pub(crate) struct Driver<A: Search> {
+    saved: Saved<A>,
+    id: u64,
+}
+
+/// What a run's save holds: all of it but its identity.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(bound(
     serialize = "A: Serialize, A::State: Serialize, A::Step: Serialize",
     deserialize = "A: Deserialize<'de>, A::State: Deserialize<'de>, A::Step: Deserialize<'de>"
 ))]
-#[serde(try_from = "Saved<A>")]
-pub(crate) struct Driver<A: Search> {
+#[serde(deny_unknown_fields)]
+struct Saved<A: Search> {
     search: A,
     state: A::State,
     records: Vec<GenerationRecord>,
@@ -99,52 +107,48 @@ pub(crate) struct Driver<A: Search> {
     stop_requested: bool,
     /// Tells taken: the number of the next ask's ticket.
     told: u64,
-    /// This run's identity in its tickets (a restored run has a new one).
-    #[serde(skip)]
-    id: u64,
 }
 
-/// A saved driver, checked before it becomes one.
-#[derive(Deserialize)]
-#[serde(bound(deserialize = "A: Deserialize<'de>, A::State: Deserialize<'de>, A::Step: Deserialize<'de>"))]
-#[serde(deny_unknown_fields)]
-struct Saved<A: Search> {
-    search: A,
-    state: A::State,
-    records: Vec<GenerationRecord>,
-    generation: usize,
-    phase: Phase<A::Step>,
-    stop_requested: bool,
-    told: u64,
-}
-
-impl<A: Search> TryFrom<Saved<A>> for Driver<A> {
-    type Error = RunError;
-
-    fn try_from(saved: Saved<A>) -> Result<Driver<A>, RunError> {
-        let step = match &saved.phase {
+impl<A: Search> Saved<A> {
+    /// Checks a restored run against its own settings.
+    fn check(&self) -> Result<(), RunError> {
+        let step = match &self.phase {
             Phase::Asking(step) => Some(step),
             _ => None,
         };
-        saved.search.check(&saved.state, step)?;
-        let recorded = matches!(saved.phase, Phase::Recorded(_) | Phase::Ended(_));
-        let complete = saved.generation - usize::from(!recorded);
-        if saved.generation == 0 || saved.generation > saved.search.generations() || saved.records.len() != complete {
+        self.search.check(&self.state, step)?;
+        let recorded = matches!(self.phase, Phase::Recorded(_) | Phase::Ended(_));
+        let complete = self.generation.saturating_sub(usize::from(!recorded));
+        if self.generation == 0 || self.generation > self.search.generations() || self.records.len() != complete {
             return Err(RunError::Restore(format!(
                 "generation {} with {} records does not fit a run of {} generations",
-                saved.generation,
-                saved.records.len(),
-                saved.search.generations()
+                self.generation,
+                self.records.len(),
+                self.search.generations()
             )));
         }
+        Ok(())
+    }
+}
+
+impl<A: Search> Serialize for Driver<A>
+where
+    Saved<A>: Serialize,
+{
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.saved.serialize(serializer)
+    }
+}
+
+impl<'de, A: Search> Deserialize<'de> for Driver<A>
+where
+    Saved<A>: Deserialize<'de>,
+{
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Driver<A>, D::Error> {
+        let saved = Saved::deserialize(deserializer)?;
+        saved.check().map_err(serde::de::Error::custom)?;
         Ok(Driver {
-            search: saved.search,
-            state: saved.state,
-            records: saved.records,
-            generation: saved.generation,
-            phase: saved.phase,
-            stop_requested: saved.stop_requested,
-            told: saved.told,
+            saved,
             id: new_run_id(),
         })
     }
@@ -155,28 +159,30 @@ impl<A: Search> Driver<A> {
     pub(crate) fn new(search: A, state: A::State) -> Driver<A> {
         let reserved = search.generations().min(RECORDS_RESERVED);
         Driver {
-            search,
-            state,
-            records: Vec::with_capacity(reserved),
-            generation: 1,
-            phase: Phase::Next,
-            stop_requested: false,
-            told: 0,
+            saved: Saved {
+                search,
+                state,
+                records: Vec::with_capacity(reserved),
+                generation: 1,
+                phase: Phase::Next,
+                stop_requested: false,
+                told: 0,
+            },
             id: new_run_id(),
         }
     }
 
     /// The search (its settings, seed and stop conditions).
     pub(crate) fn search(&self) -> &A {
-        &self.search
+        &self.saved.search
     }
 
     /// The result of the ended run; [`RunError::NotEnded`] before.
     pub(crate) fn into_result(self) -> Result<RunResult, RunError> {
         let ending = self.ending().ok_or(RunError::NotEnded)?;
         Ok(RunResult {
-            champion: A::into_champion(self.state).expect("every generation has a champion"),
-            records: self.records,
+            champion: A::into_champion(self.saved.state).expect("every generation has a champion"),
+            records: self.saved.records,
             ending,
         })
     }
@@ -186,24 +192,26 @@ impl<A: Search> Driver<A> {
     /// last generation; `None` goes on.
     fn decide(&self, decision: Option<Ending>) -> Option<Ending> {
         decision
-            .or(self.stop_requested.then_some(Ending::Stopped))
-            .or((self.generation == self.search.generations()).then_some(Ending::Completed))
+            .or(self.saved.stop_requested.then_some(Ending::Stopped))
+            .or((self.saved.generation == self.saved.search.generations()).then_some(Ending::Completed))
     }
 
     /// Moves on to the next networks to ask for, or to the end.
     fn prepare(&mut self) -> Result<(), RunError> {
         loop {
-            match self.phase {
+            match self.saved.phase {
                 Phase::Recorded(decision) => {
-                    self.phase = match self.decide(decision) {
+                    self.saved.phase = match self.decide(decision) {
                         Some(ending) => Phase::Ended(ending),
                         None => {
-                            self.generation += 1;
+                            self.saved.generation += 1;
                             Phase::Next
                         }
                     }
                 }
-                Phase::Next => self.phase = Phase::Asking(self.search.begin(&self.state, self.generation)?),
+                Phase::Next => {
+                    self.saved.phase = Phase::Asking(self.saved.search.begin(&self.saved.state, self.saved.generation)?)
+                }
                 Phase::Asking(_) | Phase::Ended(_) => return Ok(()),
             }
         }
@@ -213,11 +221,12 @@ impl<A: Search> Driver<A> {
 impl<A: Search> AskTell for Driver<A> {
     fn ask(&mut self) -> Result<Option<Asked<'_>>, RunError> {
         self.prepare()?;
-        let ticket = Ticket::new(self.id, self.told);
-        Ok(match &self.phase {
+        let ticket = Ticket::new(self.id, self.saved.told);
+        Ok(match &self.saved.phase {
             Phase::Asking(step) => Some(
-                self.search
-                    .asked(&self.state, step, self.generation)
+                self.saved
+                    .search
+                    .asked(&self.saved.state, step, self.saved.generation)
                     .with_ticket(ticket),
             ),
             _ => None,
@@ -228,41 +237,49 @@ impl<A: Search> AskTell for Driver<A> {
         if self.ending().is_some() {
             return Err(RunError::Ended);
         }
-        ticket.check(self.id, self.told)?;
-        let expected = match &self.phase {
-            Phase::Asking(step) => self.search.asked(&self.state, step, self.generation).len(),
+        ticket.check(self.id, self.saved.told)?;
+        let expected = match &self.saved.phase {
+            Phase::Asking(step) => self
+                .saved
+                .search
+                .asked(&self.saved.state, step, self.saved.generation)
+                .len(),
             _ => {
                 return Err(RunError::TicketTold {
-                    ticket: self.told,
-                    told: self.told,
+                    ticket: self.saved.told,
+                    told: self.saved.told,
                 })
             }
         };
         check_told(fitness, expected)?;
-        let Phase::Asking(step) = std::mem::replace(&mut self.phase, Phase::Next) else {
+        let Phase::Asking(step) = std::mem::replace(&mut self.saved.phase, Phase::Next) else {
             unreachable!("checked above")
         };
-        self.told += 1;
-        match self.search.advance(&mut self.state, step, fitness, self.generation) {
+        self.saved.told += 1;
+        match self
+            .saved
+            .search
+            .advance(&mut self.saved.state, step, fitness, self.saved.generation)
+        {
             Advance::Ask(step) => {
-                self.phase = Phase::Asking(step);
+                self.saved.phase = Phase::Asking(step);
                 Ok(None)
             }
             Advance::Begin => Ok(None),
             Advance::Record(record) => {
-                self.phase = Phase::Recorded(self.search.stop_at().decide(&record, Control::Continue));
-                self.records.push(record);
-                Ok(self.records.last())
+                self.saved.phase = Phase::Recorded(self.saved.search.stop_at().decide(&record, Control::Continue));
+                self.saved.records.push(record);
+                Ok(self.saved.records.last())
             }
         }
     }
 
     fn stop(&mut self) {
-        self.stop_requested = true;
+        self.saved.stop_requested = true;
     }
 
     fn ending(&self) -> Option<Ending> {
-        match self.phase {
+        match self.saved.phase {
             Phase::Ended(ending) => Some(ending),
             Phase::Recorded(decision) => self.decide(decision),
             Phase::Next | Phase::Asking(_) => None,
@@ -270,16 +287,16 @@ impl<A: Search> AskTell for Driver<A> {
     }
 
     fn records(&self) -> &[GenerationRecord] {
-        &self.records
+        &self.saved.records
     }
 
     fn result(&self) -> Result<RunResult, RunError> {
         let ending = self.ending().ok_or(RunError::NotEnded)?;
         Ok(RunResult {
-            champion: A::champion(&self.state)
+            champion: A::champion(&self.saved.state)
                 .cloned()
                 .expect("every generation has a champion"),
-            records: self.records.clone(),
+            records: self.saved.records.clone(),
             ending,
         })
     }

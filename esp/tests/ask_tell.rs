@@ -8,44 +8,11 @@ use esp_neuroevolution::{
     evaluate_all, evaluate_each_part, AskPurpose, AskTell, Control, Ending, Esp, EspSettings, Evaluator, FnEvaluator,
     GenerationRecord, HillClimb, HillClimbSettings, Part, RunError, RunResult, StopAt, TopologyMode,
 };
-use rand::RngExt;
 
-/// A noisy function to fit: output 0 should be x^2 at 8 points x in [0, 1]
-/// drawn from the evaluation's stream (inputs x and a bias), so a network
-/// evaluated with another stream scores differently; the error is
-/// rounded to steps of 0.25, so the search stagnates often.
-fn problem() -> impl Evaluator<Worker = ()> {
-    FnEvaluator::new(2, 1, |net: &Network, rng: &mut Stream| {
-        let mut out = [0.0];
-        let mut error = 0.0;
-        for _ in 0..8 {
-            let x: f64 = rng.random();
-            net.activate(&[x, 1.0], &mut out);
-            error += (out[0] - x * x).powi(2);
-        }
-        Ok(-(error * 4.0).round() / 4.0)
-    })
-}
+mod common;
 
-/// Settings that stagnate often: bursts and lesion tests (both kinds for
-/// discard-all) within a few dozen generations.
-fn small(settings: EspSettings) -> EspSettings {
-    EspSettings {
-        subpop_size: 8,
-        trials_per_neuron: 2,
-        initial_hidden: 2,
-        generations: 80,
-        stagnation: 3,
-        bursts_before_lesion: 1,
-        ..settings
-    }
-}
-
-/// Every bit of a result: records, ending and champion (Debug prints
-/// every f64 exactly).
-fn bits(result: &RunResult) -> String {
-    format!("{:?} {:?} {:?}", result.records, result.ending, result.champion)
-}
+use common::{bits, problem, small};
+use esp_neuroevolution::rand::RngExt;
 
 /// Drives `run` by hand: each asked network evaluated one by one with its
 /// stream, on this thread; returns the result and the purposes asked.

@@ -2,19 +2,15 @@
 //! fitness of any sign, careless inputs answered by typed errors, and the
 //! stagnation rule's minimum improvement.
 
+mod common;
+
+use common::{bits, problem, small};
 use esp_neuroevolution::network::Network;
-use esp_neuroevolution::rand::RngExt;
 use esp_neuroevolution::rng::Stream;
 use esp_neuroevolution::{
     AnyRun, AskTell, Esp, EspSettings, Evaluator, FnEvaluator, HillClimb, HillClimbSettings, RunError, RunResult,
     Sampling, SettingsError, StopAt, TopologyMode,
 };
-
-/// Every bit of a result: records, ending and champion (Debug prints
-/// every f64 exactly).
-fn bits(result: &RunResult) -> String {
-    format!("{:?} {:?} {:?}", result.records, result.ending, result.champion)
-}
 
 /// XOR's squared error over its four patterns (inputs x1, x2 and a bias).
 fn xor_error(net: &Network) -> anyhow::Result<f64> {
@@ -34,34 +30,6 @@ fn xor(offset: f64) -> impl Evaluator<Worker = ()> {
     FnEvaluator::new(3, 1, move |net: &Network, _: &mut Stream| {
         Ok(offset - (xor_error(net)? * 64.0).round() / 64.0)
     })
-}
-
-/// A noisy problem (its fitness draws from the network's stream) whose
-/// runs stagnate often: bursts and lesion tests of both kinds.
-fn noisy() -> impl Evaluator<Worker = ()> {
-    FnEvaluator::new(2, 1, |net: &Network, rng: &mut Stream| {
-        let mut out = [0.0];
-        let mut error = 0.0;
-        for _ in 0..8 {
-            let x: f64 = rng.random();
-            net.try_activate(&[x, 1.0], &mut out)?;
-            error += (out[0] - x * x).powi(2);
-        }
-        Ok(-(error * 4.0).round() / 4.0)
-    })
-}
-
-/// Small settings that stagnate within a few generations.
-fn small(settings: EspSettings) -> EspSettings {
-    EspSettings {
-        subpop_size: 8,
-        trials_per_neuron: 2,
-        initial_hidden: 2,
-        generations: 60,
-        stagnation: 3,
-        bursts_before_lesion: 1,
-        ..settings
-    }
 }
 
 /// Drives `run` to its end; after every `every`-th tell (counting from
@@ -88,7 +56,7 @@ where
 
 #[test]
 fn an_esp_run_saved_and_restored_anywhere_ends_as_one_never_stopped() {
-    let evaluator = noisy();
+    let evaluator = problem();
     for settings in [EspSettings::gomez(), EspSettings::hoverstad()] {
         let esp = Esp::new(small(settings), 4).unwrap();
         let whole = esp.run(&evaluator, |_| {}).unwrap();
@@ -108,7 +76,7 @@ fn an_esp_run_saved_and_restored_anywhere_ends_as_one_never_stopped() {
 
 #[test]
 fn a_hill_climbing_run_saved_and_restored_anywhere_ends_as_one_never_stopped() {
-    let evaluator = noisy();
+    let evaluator = problem();
     for elitist in [false, true] {
         let hill_climb = HillClimb::new(
             HillClimbSettings {
@@ -134,7 +102,7 @@ fn a_hill_climbing_run_saved_and_restored_anywhere_ends_as_one_never_stopped() {
 
 #[test]
 fn a_saved_run_that_does_not_fit_its_settings_is_refused_and_old_tickets_are_foreign() {
-    let evaluator = noisy();
+    let evaluator = problem();
     let esp = Esp::new(small(EspSettings::gomez()), 2).unwrap();
     let mut run = esp.start(2, 1).unwrap();
     let ticket = run.ask().unwrap().unwrap().ticket();
@@ -284,7 +252,7 @@ fn a_minimum_improvement_lets_a_creeping_run_burst() {
 fn runs_in_lockstep_saved_after_a_round_resume_to_their_own_runs() {
     use esp_neuroevolution::lockstep::lockstep_with;
     use esp_neuroevolution::Control;
-    let evaluator = noisy();
+    let evaluator = problem();
     let esp = Esp::new(small(EspSettings::hoverstad()), 5).unwrap();
     let hill_climb = HillClimb::new(
         HillClimbSettings {

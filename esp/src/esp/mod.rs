@@ -1,5 +1,5 @@
 //! Enforced Sub-Populations (Gomez & Miikkulainen), with Høverstad's
-//! modifications as switches (docs/model.md of psa-esp describes both).
+//! modifications (his Tables 1 and 4-6) as switches.
 //!
 //! By phase: [`settings`](self::settings) (every switch and number),
 //! `population` (sub-populations, sampling, credit and breeding),
