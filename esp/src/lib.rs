@@ -5,10 +5,14 @@
 //!
 //! Both search [`Network`](network::Network)s (one hidden layer of
 //! logistic units, stored neuron by neuron as ESP needs it) against any
-//! [`Evaluator`]: a function that scores a network on your problem. Network
-//! evaluations run in parallel on rayon; every random draw comes from a
-//! counter-based stream ([`rng`]) keyed by what it is for (seed, generation,
-//! network, ...), so a run is bit-identical for any thread count.
+//! [`Evaluator`]: a function that scores a network on your problem. Higher
+//! fitness is better, of any sign (minimise a cost by returning its
+//! negative); it must be finite. Network evaluations run in parallel on
+//! [`rayon`] (the current pool: `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(|| esp.run(..))`
+//! chooses the thread count); every random draw comes from a
+//! counter-based stream ([`rng`]) keyed by what it is for (seed,
+//! generation, network, ...), so a run is bit-identical for any thread
+//! count.
 //!
 //! ```
 //! use esp_neuroevolution::network::Network;
@@ -19,7 +23,7 @@
 //!     let mut out = [0.0];
 //!     let mut error = 0.0;
 //!     for x in [0.0, 0.25, 0.5, 0.75, 1.0] {
-//!         net.activate(&[x, 1.0], &mut out);
+//!         net.try_activate(&[x, 1.0], &mut out)?; // a wrong length is an error, not a panic
 //!         error += (out[0] - x).powi(2);
 //!     }
 //!     Ok(-error)
@@ -31,9 +35,16 @@
 //!
 //! A run can also be driven from outside, by ask and tell ([`AskTell`]):
 //! [`Esp::start`] and [`HillClimb::start`] make runs that ask for networks
-//! and are told their fitness; [`lockstep`] advances many such runs
-//! together, evaluating every round's networks of all of them in one batch.
-//! Either way a run is the one [`Esp::run`] gives, bit for bit.
+//! and are told their fitness with the ask's [`Ticket`]; [`lockstep`]
+//! advances many such runs together, evaluating every round's networks of
+//! all of them in one batch. Either way a run is the one [`Esp::run`]
+//! gives, bit for bit. A run under way ([`EspRun`], [`HillClimbRun`],
+//! [`AnyRun`]) is serde as a whole: saved at any point and restored, it
+//! ends as the run never stopped would have; so are its
+//! [`Network`](network::Network)s, [`Champion`] and [`RunResult`].
+//!
+//! [`progress`] is a ready-made per-generation callback; [`limits`] holds
+//! every setting's bounds.
 
 mod any_run;
 mod ask;
