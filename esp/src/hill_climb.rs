@@ -27,29 +27,41 @@ use crate::{
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct HillClimbSettings {
-    /// Hidden neurons of the network. `[chosen]` 5
+    /// Hidden neurons of the network. Default 5 `[chosen]`, as ESP's
+    /// start. Bounds: 1 to 100.
     pub hidden: usize,
-    /// Candidates per cycle (K). `[chosen]` 400
+    /// Candidates per cycle (K). Default 400 `[chosen]`, ESP's networks a
+    /// generation. Bounds: 1 to 100,000.
     pub candidates: usize,
-    /// Cycles. `[chosen]` 2000
+    /// Cycles. Default 2000 `[chosen]`, ESP's generations. Bounds: 1 to
+    /// 1,000,000.
     pub cycles: usize,
-    /// Initial weights are uniform in (-range, range). `[paper]` 6
+    /// Initial weights are uniform in (-range, range). Default 6 `[paper]`,
+    /// as ESP. Bounds: (0, 1e6].
     pub init_range: f64,
-    /// Probability that a weight gets Cauchy noise. `[chosen]` 0.2
+    /// Probability that a weight gets Cauchy noise. Default 0.2 `[chosen]`.
+    /// Bounds: [0, 1].
     pub p_noise: f64,
-    /// Scale of that noise (alpha). `[chosen]` 1.0
+    /// Scale of that noise (alpha). Default 1 `[chosen]`. Bounds: (0, 1e6].
     pub alpha: f64,
-    /// Probability that a weight then changes sign. `[chosen]` 0.05
+    /// Probability that a weight then changes sign. Default 0.05
+    /// `[chosen]`. Bounds: [0, 1].
     pub p_flip: f64,
-    /// p_noise is multiplied by this after every cycle. `[chosen]` 0.999
+    /// p_noise is multiplied by this after every cycle. Default 0.999
+    /// `[chosen]`. Bounds: (0, 1e6].
     pub anneal_noise: f64,
-    /// alpha is multiplied by this after every cycle. `[chosen]` 0.999
+    /// alpha is multiplied by this after every cycle. Default 0.999
+    /// `[chosen]`. Bounds: (0, 1e6].
     pub anneal_alpha: f64,
-    /// p_flip is multiplied by this after every cycle. `[chosen]` 0.999
+    /// p_flip is multiplied by this after every cycle (the product capped
+    /// at 1). Default 0.999 `[chosen]`. Bounds: (0, 1e6].
     pub anneal_flip: f64,
-    /// Keep the base unless a candidate is at least as good (reported worse). `[paper]` false
+    /// Keep the base unless a candidate is at least as good (Høverstad
+    /// reports it worse). Default false `[paper]`.
     pub elitist: bool,
-    /// Cauchy draws larger than this in magnitude are drawn again. `[chosen]` 10, as ESP
+    /// Cauchy draws larger than this in magnitude are drawn again. Default
+    /// 10 `[chosen]`, as ESP. Bounds: (0, 1e6] and at least 0.1 x the
+    /// largest annealed alpha.
     pub cauchy_limit: f64,
 }
 
