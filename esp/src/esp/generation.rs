@@ -41,9 +41,13 @@ impl Step {
                         .enumerate()
                         .all(|(i, subpop)| picks.networks().all(|pick| pick[i] < subpop.len()))
             }
-            Step::Lesion { variants, .. } => variants
-                .iter()
-                .all(|v| (v.inputs(), v.outputs()) == (state.inputs, state.outputs)),
+            // The whole network, then each of its neurons lesioned.
+            Step::Lesion { variants, .. } => variants.first().is_some_and(|whole| {
+                variants.len() == whole.hidden() + 1
+                    && variants
+                        .iter()
+                        .all(|v| (v.inputs(), v.outputs(), v.hidden()) == (state.inputs, state.outputs, whole.hidden()))
+            }),
         };
         if fits {
             Ok(())

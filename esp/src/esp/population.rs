@@ -6,7 +6,7 @@ use rand::seq::SliceRandom;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-use super::{Credit, Esp, EspSettings, Sampling};
+use super::{BurstMode, Credit, Esp, EspSettings, Sampling};
 use crate::network::Network;
 use crate::operators::{crossover, mutate_one_gene};
 use crate::purpose;
@@ -69,10 +69,16 @@ impl State {
             && self.subpops.iter().all(|subpop| {
                 subpop.genes_per_neuron() == per && subpop.is_whole() && subpop.len() == settings.subpop_size
             });
-        let best_fits = self
-            .best
-            .as_ref()
-            .is_none_or(|(best, _)| (best.inputs(), best.outputs()) == (self.inputs, self.outputs));
+        // Gomez's burst rebuilds the sub-populations of the best network's
+        // neurons; discard-all's may keep one more neuron than there are
+        // sub-populations (a removal applied after the burst).
+        let most_hidden = match settings.burst {
+            BurstMode::Gomez => self.subpops.len(),
+            BurstMode::DiscardAll => self.subpops.len() + 1,
+        };
+        let best_fits = self.best.as_ref().is_none_or(|(best, _)| {
+            (best.inputs(), best.outputs()) == (self.inputs, self.outputs) && best.hidden() <= most_hidden
+        });
         if subpops_fit && best_fits {
             Ok(())
         } else {
