@@ -1,9 +1,10 @@
 //! The lockstep grid executor: every run of a grid (or of what is left of
 //! it) advanced together, one round per generation, each round's networks
-//! of all runs evaluated in one batch (the search crate's [`lockstep`]).
+//! of all runs evaluated in one batch (the search crate's
+//! [`lockstep_with`]).
 //! Each run is the run it is on its own, bit for bit: its files are
 //! byte-identical to those of the run-by-run executor (run.json's times
-//! aside). Every [`CHECKPOINT_ROUNDS`] rounds each unfinished run saves its
+//! aside). Every `CHECKPOINT_ROUNDS` rounds each unfinished run saves its
 //! whole state to [`CHECKPOINT`] in its folder; a grid killed and started
 //! again resumes each run from there, to the same files.
 
