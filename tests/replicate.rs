@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use common::{psa_esp, run_file_paths};
+use common::{psa_esp, run_file_paths, run_files};
 
 /// A small grid: 3 configurations x task 1 x 4 seeds, on one thread.
 fn grid_args(out: &Path) -> Vec<String> {
@@ -101,6 +101,75 @@ fn a_grid_killed_part_way_resumes_to_the_same_results() {
     assert!(
         results(&whole) == results(&killed),
         "resumed grid differs from the uninterrupted one"
+    );
+}
+
+#[test]
+fn a_lockstep_grid_killed_part_way_resumes_from_its_checkpoints_to_the_same_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (whole, killed) = (tmp.path().join("whole"), tmp.path().join("killed"));
+    let args = |out: &Path| -> Vec<String> {
+        [
+            "replicate",
+            "--configs",
+            "baseline,hill-climb",
+            "--tasks",
+            "1",
+            "--seeds",
+            "2",
+            "--generations",
+            "400",
+            "--robustness-trials",
+            "5",
+            "--lockstep",
+            "--threads",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let o = psa_esp(&args(&whole).iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    // Kill -9 the same grid elsewhere once every run has a checkpoint.
+    let mut child = Command::new(common::binary()).args(args(&killed)).spawn().unwrap();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let checkpoints = |dir: &Path| -> usize {
+        if !dir.join("runs").exists() {
+            return 0;
+        }
+        run_file_paths(dir)
+            .iter()
+            .filter(|p| p.ends_with("checkpoint.json"))
+            .count()
+    };
+    while checkpoints(&killed) < 4 {
+        assert!(Instant::now() < deadline, "no checkpoints in time");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert_eq!(
+        finished_runs(&killed),
+        0,
+        "the grid finished before it could be killed; make it longer"
+    );
+
+    // Started again, each run resumes from its checkpoint, and the grid's
+    // files are those of the uninterrupted grid, checkpoints gone.
+    let o = Command::new(common::binary())
+        .args(args(&killed))
+        .env("RUST_LOG", "info")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let log = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(log.matches("resumed after generation").count(), 4, "{log}");
+    assert!(
+        run_files(&whole) == run_files(&killed),
+        "resumed lockstep grid differs from the uninterrupted one"
     );
 }
 

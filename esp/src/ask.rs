@@ -13,14 +13,16 @@
 
 use std::borrow::Cow;
 
-use crate::esp::Assembled;
-use crate::evaluator::evaluate_all;
+use serde::{Deserialize, Serialize};
+
+use crate::evaluator::{check_fitness, evaluate_all};
 use crate::network::{Network, NetworkSet};
 use crate::rng::StreamFamily;
-use crate::{Control, Ending, Evaluator, GenerationRecord, RunError, RunResult};
+use crate::subpop::Assembled;
+use crate::{Ending, Evaluator, GenerationRecord, RunError, RunResult};
 
 /// What a batch of asked networks is for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum AskPurpose {
     /// The networks of ESP's generation (or the hill-climber's cycle) `n`.
     Generation(usize),
@@ -37,11 +39,43 @@ pub enum AskPurpose {
 /// `streams().stream(j)` (that is, `rng::stream(seed(), [key().., j])`),
 /// which [`Asked::evaluate`] does. It reads the networks in place from
 /// the run (ESP's sub-populations and picks, say) as a [`NetworkSet`].
+/// Its [`Ticket`] is what [`AskTell::tell`] takes with their fitness.
 pub struct Asked<'a> {
     networks: Networks<'a>,
     purpose: AskPurpose,
     seed: u64,
     key: [u64; 2],
+    ticket: Ticket,
+}
+
+/// The receipt of an ask: which run asked, and which of its asks this is.
+/// [`AskTell::tell`] takes it with the fitness, and refuses one of another
+/// run or of an ask told already, so that fitness is never applied to
+/// networks it was not computed for. A restored run (serde) issues new
+/// tickets: those of the run it was saved from are foreign to it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Ticket {
+    run: u64,
+    ask: u64,
+}
+
+impl Ticket {
+    /// The ticket of run `run`'s ask after `told` tells.
+    pub(crate) fn new(run: u64, told: u64) -> Ticket {
+        Ticket { run, ask: told }
+    }
+
+    /// Checks that this ticket is the one run `run` issues after `told`
+    /// tells.
+    pub(crate) fn check(self, run: u64, told: u64) -> Result<(), RunError> {
+        if self.run != run {
+            Err(RunError::ForeignTicket)
+        } else if self.ask != told {
+            Err(RunError::TicketTold { ticket: self.ask, told })
+        } else {
+            Ok(())
+        }
+    }
 }
 
 /// Where an ask's networks live.
@@ -53,14 +87,26 @@ pub(crate) enum Networks<'a> {
 }
 
 impl<'a> Asked<'a> {
-    /// The networks of `purpose`, with the streams of `seed` and `key`.
+    /// The networks of `purpose`, with the streams of `seed` and `key`;
+    /// their ticket is made by the run driver ([`Asked::with_ticket`]).
     pub(crate) fn new(networks: Networks<'a>, purpose: AskPurpose, seed: u64, key: [u64; 2]) -> Asked<'a> {
         Asked {
             networks,
             purpose,
             seed,
             key,
+            ticket: Ticket::new(0, 0),
         }
+    }
+
+    /// These networks under `ticket`.
+    pub(crate) fn with_ticket(self, ticket: Ticket) -> Asked<'a> {
+        Asked { ticket, ..self }
+    }
+
+    /// The ticket to tell their fitness with.
+    pub fn ticket(&self) -> Ticket {
+        self.ticket
     }
 
     /// What the networks are for.
@@ -131,9 +177,10 @@ impl NetworkSet for Asked<'_> {
 }
 
 /// A run driven from outside: [`AskTell::ask`] for networks,
-/// [`AskTell::tell`] their fitness, until `ask` answers `None`. ESP's
-/// [`EspRun`](crate::EspRun) and the hill-climber's
-/// [`HillClimbRun`](crate::HillClimbRun) are ones.
+/// [`AskTell::tell`] their fitness with the ask's [`Ticket`], until `ask`
+/// answers `None`. ESP's [`EspRun`](crate::EspRun) and the hill-climber's
+/// [`HillClimbRun`](crate::HillClimbRun) are ones, and [`AnyRun`](crate::AnyRun)
+/// either.
 ///
 /// ```
 /// use esp_neuroevolution::network::Network;
@@ -148,8 +195,8 @@ impl NetworkSet for Asked<'_> {
 /// let mut run = esp.start(2, 1)?;
 /// while let Some(asked) = run.ask()? {
 ///     // Evaluate anywhere, any way, as long as network j uses asked.streams().stream(j).
-///     let fitness = asked.evaluate(&evaluator)?;
-///     if let Some(record) = run.tell(&fitness)? {
+///     let (ticket, fitness) = (asked.ticket(), asked.evaluate(&evaluator)?);
+///     if let Some(record) = run.tell(ticket, &fitness)? {
 ///         println!("generation {}: best {}", record.generation, record.max);
 ///     }
 /// }
@@ -160,20 +207,24 @@ impl NetworkSet for Asked<'_> {
 /// ```
 pub trait AskTell {
     /// The networks to evaluate next, or `None` once the run has ended.
-    /// Asking again before telling asks for the same networks. Fails when
-    /// the search's weights overflowed.
+    /// Asking again before telling asks for the same networks, under the
+    /// same ticket. Fails when the search's weights overflowed.
     fn ask(&mut self) -> Result<Option<Asked<'_>>, RunError>;
 
-    /// Advances the run by the fitness of the asked networks, in order.
+    /// Advances the run by the fitness of the networks that the ask of
+    /// `ticket` asked for, in order (higher is better; any sign).
     /// Returns the record of the generation (cycle) this completes, if it
-    /// completes one. Fails, leaving the run as it was, on a count of
-    /// fitnesses other than the ask's ([`RunError::FitnessCount`]), on a
-    /// NaN ([`RunError::NanFitness`]) or once the run has ended
-    /// ([`RunError::Ended`]).
-    fn tell(&mut self, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError>;
+    /// completes one. Fails, leaving the run as it was, once the run has
+    /// ended ([`RunError::Ended`]), on another run's ticket
+    /// ([`RunError::ForeignTicket`]), on the ticket of an ask told already
+    /// ([`RunError::TicketTold`]: a repeated tell, or no ask since the
+    /// last tell), on a count of fitnesses other than the ask's
+    /// ([`RunError::FitnessCount`]), on a NaN ([`RunError::NanFitness`]) or
+    /// an infinity ([`RunError::InfiniteFitness`]).
+    fn tell(&mut self, ticket: Ticket, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError>;
 
     /// Ends the run once its current generation (cycle) is complete, as a
-    /// per-generation callback of `run` returning [`Control::Stop`] does;
+    /// per-generation callback of `run` returning [`Control::Stop`](crate::Control::Stop) does;
     /// the run's [`Ending`] is then [`Ending::Stopped`] unless its goal or
     /// budget ended it there first.
     fn stop(&mut self);
@@ -193,8 +244,8 @@ impl<T: AskTell + ?Sized> AskTell for Box<T> {
     fn ask(&mut self) -> Result<Option<Asked<'_>>, RunError> {
         (**self).ask()
     }
-    fn tell(&mut self, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError> {
-        (**self).tell(fitness)
+    fn tell(&mut self, ticket: Ticket, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError> {
+        (**self).tell(ticket, fitness)
     }
     fn stop(&mut self) {
         (**self).stop()
@@ -210,26 +261,7 @@ impl<T: AskTell + ?Sized> AskTell for Box<T> {
     }
 }
 
-/// Drives `run` to its end on the current rayon pool: ask, evaluate with
-/// `evaluator`, tell, and call `on_generation` with every record (its
-/// [`Control::Stop`] stops the run).
-pub(crate) fn drive<R: AskTell + ?Sized, E: Evaluator, C: Into<Control>>(
-    run: &mut R,
-    evaluator: &E,
-    mut on_generation: impl FnMut(&GenerationRecord) -> C,
-) -> Result<(), RunError> {
-    while let Some(asked) = run.ask()? {
-        let fitness = asked.evaluate(evaluator)?;
-        if let Some(record) = run.tell(&fitness)? {
-            if on_generation(record).into() == Control::Stop {
-                run.stop();
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Checks told fitness against the ask: its count, then NaN.
+/// Checks told fitness against the ask: its count, then NaN and infinity.
 pub(crate) fn check_told(fitness: &[f64], expected: usize) -> Result<(), RunError> {
     if fitness.len() != expected {
         return Err(RunError::FitnessCount {
@@ -237,8 +269,5 @@ pub(crate) fn check_told(fitness: &[f64], expected: usize) -> Result<(), RunErro
             got: fitness.len(),
         });
     }
-    match fitness.iter().position(|f| f.is_nan()) {
-        Some(network) => Err(RunError::NanFitness { network }),
-        None => Ok(()),
-    }
+    check_fitness(fitness, 0)
 }

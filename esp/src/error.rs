@@ -73,6 +73,22 @@ pub enum SettingsError {
         /// The least limit per scale.
         ratio: f64,
     },
+    /// A value that must be finite and >= 0 and is not.
+    #[error("{name} must be finite and >= 0, got {value}")]
+    Negative {
+        /// The setting.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A value that must be finite and is NaN or infinite.
+    #[error("{name} must be finite, got {value}")]
+    NotFinite {
+        /// The setting.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
     /// A count below its minimum.
     #[error("{name} must be >= {min}, got {value}")]
     TooFew {
@@ -100,6 +116,19 @@ pub enum RunError {
         /// The network's index in the call.
         network: usize,
     },
+    /// The evaluator returned an infinite fitness, which the ranking of
+    /// networks and neurons cannot use (a mean of +inf and -inf is NaN, a
+    /// lesion test's share of infinity is undefined).
+    #[error("the evaluation returned {value} for network {network}: fitness must be finite")]
+    InfiniteFitness {
+        /// The network's index in the call.
+        network: usize,
+        /// The fitness.
+        value: f64,
+    },
+    /// A run's settings or stop conditions are out of range.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
     /// ESP's weights overflowed to infinity or NaN.
     #[error(
         "weight {gene} of neuron {neuron} of sub-population {subpop} is not finite ({value}): \
@@ -127,9 +156,26 @@ pub enum RunError {
         /// Fitnesses told.
         got: usize,
     },
+    /// A run was told fitnesses with a ticket of another run (or of this
+    /// run before it was saved and restored).
+    #[error("the ticket belongs to another run: tell a run what its own ask asked")]
+    ForeignTicket,
+    /// A run was told fitnesses for an ask it was told already: a tell
+    /// repeated, or a tell with no ask since the last one.
+    #[error("ask {ticket} was told already (this run has been told {told} times): ask again, then tell")]
+    TicketTold {
+        /// The ask the ticket names, counting tells from 0.
+        ticket: u64,
+        /// Tells the run has taken.
+        told: u64,
+    },
     /// A run was told fitnesses after it had ended.
     #[error("the run has ended: it asks for no more networks")]
     Ended,
+    /// A saved run that does not fit its own settings (written by another
+    /// version, or changed by hand).
+    #[error("cannot restore the run: {0}")]
+    Restore(String),
     /// A run's result was asked for before it ended.
     #[error("the run has not ended: it still asks for networks")]
     NotEnded,

@@ -24,7 +24,9 @@ pub trait Evaluator: Sync {
     /// Makes the per-thread state.
     fn worker(&self) -> Result<Self::Worker>;
     /// The fitness of `network`; all randomness must come from `rng`, so that
-    /// the same network and stream give the same fitness. Higher is better.
+    /// the same network and stream give the same fitness. Higher is better,
+    /// of any sign (to minimise a cost, return its negative); it must be
+    /// finite ([`RunError::NanFitness`], [`RunError::InfiniteFitness`]).
     fn evaluate(&self, worker: &mut Self::Worker, network: &Network, rng: &mut Stream) -> Result<f64>;
 
     /// How many networks [`Evaluator::evaluate_batch`] takes at a time to
@@ -190,11 +192,15 @@ pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
         .collect()
 }
 
-/// An error naming the first network whose fitness is NaN; `first` is the
-/// index of `fitness[0]`.
+/// An error naming the first network whose fitness is NaN or infinite;
+/// `first` is the index of `fitness[0]`.
 pub(crate) fn check_fitness(fitness: &[f64], first: usize) -> Result<(), RunError> {
-    match fitness.iter().position(|f| f.is_nan()) {
-        Some(i) => Err(RunError::NanFitness { network: first + i }),
+    match fitness.iter().position(|f| !f.is_finite()) {
+        Some(i) if fitness[i].is_nan() => Err(RunError::NanFitness { network: first + i }),
+        Some(i) => Err(RunError::InfiniteFitness {
+            network: first + i,
+            value: fitness[i],
+        }),
         None => Ok(()),
     }
 }

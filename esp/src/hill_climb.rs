@@ -1,48 +1,67 @@
-//! Høverstad's parallel stochastic hill-climber (`algorithms.md` §3).
+//! Høverstad's parallel stochastic hill-climber: every cycle, mutate the
+//! base network into candidates, evaluate them, and take the best as the
+//! next base (elitist: only when at least as good).
 
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-use super::ask::{check_told, drive, AskPurpose, AskTell, Asked, Networks};
-use super::operators::{cauchy, random_genes};
-use super::{
-    best_of, check_cauchy_limit, check_count, check_positive, check_probability, min_and_mean, purpose,
-    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION,
-};
-use super::{
-    Champion, Control, Ending, Evaluator, GenerationRecord, RunError, RunResult, SettingsError, StopAt,
-    RECORDS_RESERVED,
+use crate::ask::{AskPurpose, Asked, Networks};
+use crate::limits::{
+    check_cauchy_limit, check_count, check_positive, check_probability, MAX_GENERATIONS, MAX_HIDDEN,
+    MAX_NETWORKS_PER_GENERATION,
 };
 use crate::network::Network;
+use crate::operators::{cauchy, random_genes};
 use crate::rng::{stream, Stream};
+use crate::run::{drive, public_run, Advance, Driver, Search};
+use crate::{
+    best_of, min_and_mean, purpose, Champion, Control, Evaluator, GenerationRecord, RunError, RunResult, SettingsError,
+    StopAt,
+};
 
-/// Every setting of the hill-climber (`[chosen]` defaults give it ESP's budget).
+/// Every setting of the hill-climber, named in configuration files as
+/// `hill_climb.<field>`. Høverstad's paper gives the algorithm but few
+/// numbers: the defaults marked `[chosen]` are chosen here (they give it
+/// ESP's budget of 400 networks a cycle for 2000 cycles), those marked
+/// `[paper]` are his. Bounds are checked by [`HillClimbSettings::validate`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct HillClimbSettings {
-    /// Hidden neurons of the network. `[chosen]` 5
+    /// Hidden neurons of the network. Default 5 `[chosen]`, as ESP's
+    /// start. Bounds: 1 to 100.
     pub hidden: usize,
-    /// Candidates per cycle (K). `[chosen]` 400
+    /// Candidates per cycle (K). Default 400 `[chosen]`, ESP's networks a
+    /// generation. Bounds: 1 to 100,000.
     pub candidates: usize,
-    /// Cycles. `[chosen]` 2000
+    /// Cycles. Default 2000 `[chosen]`, ESP's generations. Bounds: 1 to
+    /// 1,000,000.
     pub cycles: usize,
-    /// Initial weights are uniform in (-range, range). `[paper]` 6
+    /// Initial weights are uniform in (-range, range). Default 6 `[paper]`,
+    /// as ESP. Bounds: (0, 1e6].
     pub init_range: f64,
-    /// Probability that a weight gets Cauchy noise. `[chosen]` 0.2
+    /// Probability that a weight gets Cauchy noise. Default 0.2 `[chosen]`.
+    /// Bounds: [0, 1].
     pub p_noise: f64,
-    /// Scale of that noise (alpha). `[chosen]` 1.0
+    /// Scale of that noise (alpha). Default 1 `[chosen]`. Bounds: (0, 1e6].
     pub alpha: f64,
-    /// Probability that a weight then changes sign. `[chosen]` 0.05
+    /// Probability that a weight then changes sign. Default 0.05
+    /// `[chosen]`. Bounds: [0, 1].
     pub p_flip: f64,
-    /// p_noise is multiplied by this after every cycle. `[chosen]` 0.999
+    /// p_noise is multiplied by this after every cycle. Default 0.999
+    /// `[chosen]`. Bounds: (0, 1e6].
     pub anneal_noise: f64,
-    /// alpha is multiplied by this after every cycle. `[chosen]` 0.999
+    /// alpha is multiplied by this after every cycle. Default 0.999
+    /// `[chosen]`. Bounds: (0, 1e6].
     pub anneal_alpha: f64,
-    /// p_flip is multiplied by this after every cycle. `[chosen]` 0.999
+    /// p_flip is multiplied by this after every cycle (the product capped
+    /// at 1). Default 0.999 `[chosen]`. Bounds: (0, 1e6].
     pub anneal_flip: f64,
-    /// Keep the base unless a candidate is at least as good (reported worse). `[paper]` false
+    /// Keep the base unless a candidate is at least as good (Høverstad
+    /// reports it worse). Default false `[paper]`.
     pub elitist: bool,
-    /// Cauchy draws larger than this in magnitude are drawn again. `[chosen]` 10, as ESP
+    /// Cauchy draws larger than this in magnitude are drawn again. Default
+    /// 10 `[chosen]`, as ESP. Bounds: (0, 1e6] and at least 0.1 x the
+    /// largest annealed alpha.
     pub cauchy_limit: f64,
 }
 
@@ -107,7 +126,7 @@ pub struct MutationRates {
 }
 
 /// A hill-climbing run: settings, seed and when to stop early.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HillClimb {
     settings: HillClimbSettings,
     seed: u64,
@@ -125,21 +144,29 @@ impl HillClimb {
         })
     }
 
-    /// This run, ending early when `stop` says so.
+    /// This run, ending early when `stop` says so (checked when the run
+    /// starts: [`StopAt::validate`]).
     pub fn stop_at(self, stop: StopAt) -> HillClimb {
         HillClimb { stop, ..self }
     }
 
+    /// The settings.
+    pub fn settings(&self) -> &HillClimbSettings {
+        &self.settings
+    }
+
     /// The rates of cycle `cycle` (from 1): each initial rate times its
-    /// annealing constant to the power `cycle - 1`.
-    pub fn rates(&self, cycle: usize) -> MutationRates {
+    /// annealing constant to the power `cycle - 1`. Cycle 0 does not exist
+    /// ([`SettingsError::TooFew`]).
+    pub fn rates(&self, cycle: usize) -> Result<MutationRates, SettingsError> {
+        check_count("cycle", cycle, 1, usize::MAX)?;
         let s = &self.settings;
-        let k = (cycle - 1) as i32;
-        MutationRates {
+        let k = i32::try_from(cycle - 1).unwrap_or(i32::MAX);
+        Ok(MutationRates {
             p_noise: s.p_noise * s.anneal_noise.powi(k),
             alpha: s.alpha * s.anneal_alpha.powi(k),
             p_flip: (s.p_flip * s.anneal_flip.powi(k)).min(1.0),
-        }
+        })
     }
 
     /// Mutates every weight: Cauchy noise with probability `p_noise`, then a
@@ -157,8 +184,9 @@ impl HillClimb {
 
     /// Starts the run on networks of `inputs` inputs (the bias included)
     /// and `outputs` outputs, to be driven by ask and tell ([`AskTell`](crate::AskTell)).
-    /// Fails on a size of 0.
+    /// Fails on a size of 0 and on stop conditions out of range.
     pub fn start(&self, inputs: usize, outputs: usize) -> Result<HillClimbRun, RunError> {
+        self.stop.validate()?;
         let s = &self.settings;
         let mut rng = stream(self.seed, &[purpose::INIT]);
         let base = Network::from_genes(
@@ -166,19 +194,13 @@ impl HillClimb {
             outputs,
             random_genes(&mut rng, s.hidden * (inputs + outputs), s.init_range),
         )?;
-        // The base's fitness matters only to elitist acceptance.
-        let phase = if s.elitist { Phase::Base } else { Phase::Next };
-        Ok(HillClimbRun {
-            hill_climb: self.clone(),
+        let state = State {
             base,
-            base_fitness: f64::NEG_INFINITY,
+            base_fitness: None,
             evaluations: 0,
             champion: None,
-            records: Vec::with_capacity(s.cycles.min(RECORDS_RESERVED)),
-            cycle: 1,
-            phase,
-            stop_requested: false,
-        })
+        };
+        Ok(HillClimbRun(Driver::new(self.clone(), state)))
     }
 
     /// Runs the cycles on the current rayon pool, calling `on_cycle` after
@@ -199,7 +221,7 @@ impl HillClimb {
     /// Cycle `cycle`'s candidates: the base mutated with the cycle's
     /// rates, candidate `j` with its own stream.
     fn candidates(&self, base: &Network, cycle: usize) -> Result<Vec<Network>, RunError> {
-        let rates = self.rates(cycle);
+        let rates = self.rates(cycle)?;
         let (inputs, outputs) = (base.inputs(), base.outputs());
         (0..self.settings.candidates)
             .map(|j| {
@@ -213,101 +235,23 @@ impl HillClimb {
             })
             .collect()
     }
-}
-
-/// A run of [`HillClimb`] under way: [`AskTell::ask`] gives the networks
-/// to evaluate next (elitist: the base first; then each cycle's
-/// candidates), [`AskTell::tell`] their fitness. Made by
-/// [`HillClimb::start`]; the same run, bit for bit, as [`HillClimb::run`].
-pub struct HillClimbRun {
-    hill_climb: HillClimb,
-    base: Network,
-    base_fitness: f64,
-    evaluations: u64,
-    champion: Option<Champion>,
-    records: Vec<GenerationRecord>,
-    /// The cycle under way, or the last one recorded.
-    cycle: usize,
-    phase: Phase,
-    /// [`AskTell::stop`] was called.
-    stop_requested: bool,
-}
-
-/// Where a hill-climbing run stands.
-enum Phase {
-    /// The base is asked (elitist acceptance, before cycle 1).
-    Base,
-    /// Cycle `cycle` is next: its candidates are not made yet.
-    Next,
-    /// Cycle `cycle`'s candidates are asked.
-    Asking(Vec<Network>),
-    /// Cycle `cycle` is recorded; the goal or the budget ended the run
-    /// there if this says so.
-    Recorded(Option<Ending>),
-    /// The run has ended.
-    Ended(Ending),
-}
-
-impl HillClimbRun {
-    /// The run's settings and stop conditions.
-    pub fn hill_climb(&self) -> &HillClimb {
-        &self.hill_climb
-    }
-
-    /// The result of the ended run; [`RunError::NotEnded`] before.
-    pub fn into_result(self) -> Result<RunResult, RunError> {
-        let ending = self.ending().ok_or(RunError::NotEnded)?;
-        Ok(RunResult {
-            champion: self.champion.expect("every cycle has a champion"),
-            records: self.records,
-            ending,
-        })
-    }
-
-    /// How the run ends after cycle `cycle`, recorded with the goal's or
-    /// budget's `decision`.
-    fn decide(&self, decision: Option<Ending>) -> Option<Ending> {
-        decision
-            .or(self.stop_requested.then_some(Ending::Stopped))
-            .or((self.cycle == self.hill_climb.settings.cycles).then_some(Ending::Completed))
-    }
-
-    /// Moves on to the next networks to ask for, or to the end.
-    fn prepare(&mut self) -> Result<(), RunError> {
-        loop {
-            match self.phase {
-                Phase::Recorded(decision) => {
-                    self.phase = match self.decide(decision) {
-                        Some(ending) => Phase::Ended(ending),
-                        None => {
-                            self.cycle += 1;
-                            Phase::Next
-                        }
-                    }
-                }
-                Phase::Next => self.phase = Phase::Asking(self.hill_climb.candidates(&self.base, self.cycle)?),
-                Phase::Base | Phase::Asking(_) | Phase::Ended(_) => return Ok(()),
-            }
-        }
-    }
 
     /// The cycle after its candidates scored `fitness`: champion, base, record.
-    fn conclude(&mut self, candidates: Vec<Network>, fitness: &[f64]) -> GenerationRecord {
-        let s = &self.hill_climb.settings;
-        let cycle = self.cycle;
+    fn conclude(&self, state: &mut State, candidates: Vec<Network>, fitness: &[f64], cycle: usize) -> GenerationRecord {
+        let s = &self.settings;
         let (top, top_fitness) = best_of(fitness);
-        if self.champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
-            self.champion = Some(Champion {
+        if state.champion.as_ref().is_none_or(|c| top_fitness > c.fitness) {
+            state.champion = Some(Champion {
                 network: candidates[top].clone(),
                 fitness: top_fitness,
                 generation: cycle,
-                evaluation: self.evaluations + top as u64 + 1,
+                evaluation: state.evaluations + top as u64 + 1,
             });
         }
-        self.evaluations += candidates.len() as u64;
-        if !s.elitist || top_fitness >= self.base_fitness {
-            self.base = candidates.into_iter().nth(top).expect("the best is a candidate");
-            self.base_fitness = top_fitness;
+        state.evaluations += candidates.len() as u64;
+        if !s.elitist || state.base_fitness.is_none_or(|base| top_fitness >= base) {
+            state.base = candidates.into_iter().nth(top).expect("the best is a candidate");
+            state.base_fitness = Some(top_fitness);
         }
         let (min, mean) = min_and_mean(fitness);
         GenerationRecord {
@@ -315,9 +259,9 @@ impl HillClimbRun {
             min,
             mean,
             max: top_fitness,
-            best: Some(self.base_fitness),
-            champion: self.champion.as_ref().map_or(f64::NAN, |c| c.fitness),
-            evaluations: self.evaluations,
+            best: state.base_fitness,
+            champion: state.champion.as_ref().map_or(f64::NAN, |c| c.fitness),
+            evaluations: state.evaluations,
             subpops: s.hidden,
             burst: false,
             bursts: 0,
@@ -326,80 +270,131 @@ impl HillClimbRun {
     }
 }
 
-impl AskTell for HillClimbRun {
-    fn ask(&mut self) -> Result<Option<Asked<'_>>, RunError> {
-        self.prepare()?;
-        let seed = self.hill_climb.seed;
-        Ok(match &self.phase {
-            Phase::Base => Some(Asked::new(
-                Networks::List(std::slice::from_ref(&self.base)),
-                AskPurpose::Base,
-                seed,
-                [purpose::EVALUATE, 0],
-            )),
-            Phase::Asking(candidates) => Some(Asked::new(
-                Networks::List(candidates),
-                AskPurpose::Generation(self.cycle),
-                seed,
-                [purpose::EVALUATE, self.cycle as u64],
-            )),
-            _ => None,
-        })
+/// A hill-climbing run's state between cycles.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub(crate) struct State {
+    /// The network the candidates are mutated from.
+    base: Network,
+    /// Its fitness, once evaluated (elitist: before cycle 1; else as the
+    /// best candidate of the last cycle).
+    base_fitness: Option<f64>,
+    /// Networks evaluated so far.
+    evaluations: u64,
+    /// The best network ever evaluated.
+    champion: Option<Champion>,
+}
+
+/// What a hill-climbing run asks for.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(crate) enum Step {
+    /// The base, for elitist acceptance, before cycle 1.
+    Base,
+    /// A cycle's candidates.
+    Candidates(Vec<Network>),
+}
+
+impl Search for HillClimb {
+    type State = State;
+    type Step = Step;
+
+    fn generations(&self) -> usize {
+        self.settings.cycles
     }
 
-    fn tell(&mut self, fitness: &[f64]) -> Result<Option<&GenerationRecord>, RunError> {
-        self.prepare()?;
-        let expected = match &self.phase {
-            Phase::Base => 1,
-            Phase::Asking(candidates) => candidates.len(),
-            _ => return Err(RunError::Ended),
+    fn stop_at(&self) -> StopAt {
+        self.stop
+    }
+
+    fn check(&self, state: &State, step: Option<&Step>) -> Result<(), RunError> {
+        self.settings.validate()?;
+        self.stop.validate()?;
+        let shape = (state.base.inputs(), state.base.outputs(), state.base.hidden());
+        let fits = |network: &Network| (network.inputs(), network.outputs(), network.hidden()) == shape;
+        let candidates_fit = match step {
+            Some(Step::Candidates(candidates)) => {
+                candidates.len() == self.settings.candidates && candidates.iter().all(fits)
+            }
+            Some(Step::Base) | None => true,
         };
-        check_told(fitness, expected)?;
-        match std::mem::replace(&mut self.phase, Phase::Next) {
-            Phase::Base => {
-                self.evaluations += 1;
-                self.base_fitness = fitness[0];
-                Ok(None)
-            }
-            Phase::Asking(candidates) => {
-                let record = self.conclude(candidates, fitness);
-                self.phase = Phase::Recorded(self.hill_climb.stop.decide(&record, Control::Continue));
-                self.records.push(record);
-                Ok(self.records.last())
-            }
-            _ => unreachable!("checked above"),
+        if state.base.hidden() == self.settings.hidden && candidates_fit {
+            Ok(())
+        } else {
+            Err(RunError::Restore(format!(
+                "the base or the candidates do not fit {} hidden neurons and {} candidates",
+                self.settings.hidden, self.settings.candidates
+            )))
         }
     }
 
-    fn stop(&mut self) {
-        self.stop_requested = true;
+    /// Cycle `cycle`'s networks: the base first where elitist acceptance
+    /// needs its fitness, else the candidates.
+    fn begin(&self, state: &State, cycle: usize) -> Result<Step, RunError> {
+        if self.settings.elitist && state.base_fitness.is_none() {
+            return Ok(Step::Base);
+        }
+        Ok(Step::Candidates(self.candidates(&state.base, cycle)?))
     }
 
-    fn ending(&self) -> Option<Ending> {
-        match self.phase {
-            Phase::Ended(ending) => Some(ending),
-            Phase::Recorded(decision) => self.decide(decision),
-            Phase::Base | Phase::Next | Phase::Asking(_) => None,
+    fn asked<'a>(&self, state: &'a State, step: &'a Step, cycle: usize) -> Asked<'a> {
+        match step {
+            Step::Base => Asked::new(
+                Networks::List(std::slice::from_ref(&state.base)),
+                AskPurpose::Base,
+                self.seed,
+                [purpose::EVALUATE, 0],
+            ),
+            Step::Candidates(candidates) => Asked::new(
+                Networks::List(candidates),
+                AskPurpose::Generation(cycle),
+                self.seed,
+                [purpose::EVALUATE, cycle as u64],
+            ),
         }
     }
 
-    fn records(&self) -> &[GenerationRecord] {
-        &self.records
+    fn advance(&self, state: &mut State, step: Step, fitness: &[f64], cycle: usize) -> Advance<Step> {
+        match step {
+            Step::Base => {
+                state.evaluations += 1;
+                state.base_fitness = Some(fitness[0]);
+                Advance::Begin
+            }
+            Step::Candidates(candidates) => Advance::Record(self.conclude(state, candidates, fitness, cycle)),
+        }
     }
 
-    fn result(&self) -> Result<RunResult, RunError> {
-        let ending = self.ending().ok_or(RunError::NotEnded)?;
-        Ok(RunResult {
-            champion: self.champion.clone().expect("every cycle has a champion"),
-            records: self.records.clone(),
-            ending,
-        })
+    fn champion(state: &State) -> Option<&Champion> {
+        state.champion.as_ref()
+    }
+
+    fn into_champion(state: State) -> Option<Champion> {
+        state.champion
+    }
+}
+
+/// A run of [`HillClimb`] under way: [`AskTell::ask`](crate::AskTell::ask)
+/// gives the networks to evaluate next (elitist: the base first; then each
+/// cycle's candidates), [`AskTell::tell`](crate::AskTell::tell) their
+/// fitness. Made by [`HillClimb::start`]; the same run, bit for bit, as
+/// [`HillClimb::run`]. Saved and restored by serde, as [`EspRun`](crate::EspRun).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct HillClimbRun(Driver<HillClimb>);
+
+public_run!(HillClimbRun);
+
+impl HillClimbRun {
+    /// The run's settings and stop conditions.
+    pub fn hill_climb(&self) -> &HillClimb {
+        self.0.search()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Ending;
     use crate::FnEvaluator;
 
     #[test]
@@ -436,14 +431,14 @@ mod tests {
         };
         let hc = HillClimb::new(settings, 1).unwrap();
         assert_eq!(
-            hc.rates(1),
+            hc.rates(1).unwrap(),
             MutationRates {
                 p_noise: 0.2,
                 alpha: 1.0,
                 p_flip: 0.05
             }
         );
-        let r = hc.rates(11);
+        let r = hc.rates(11).unwrap();
         assert!((r.p_noise - 0.2 * 0.9f64.powi(10)).abs() < 1e-15);
         assert!((r.alpha - 0.5f64.powi(10)).abs() < 1e-15);
         assert!((r.p_flip - 0.05 * 0.99f64.powi(10)).abs() < 1e-15);

@@ -5,10 +5,14 @@
 //!
 //! Both search [`Network`](network::Network)s (one hidden layer of
 //! logistic units, stored neuron by neuron as ESP needs it) against any
-//! [`Evaluator`]: a function that scores a network on your problem. Network
-//! evaluations run in parallel on rayon; every random draw comes from a
-//! counter-based stream ([`rng`]) keyed by what it is for (seed, generation,
-//! network, ...), so a run is bit-identical for any thread count.
+//! [`Evaluator`]: a function that scores a network on your problem. Higher
+//! fitness is better, of any sign (minimise a cost by returning its
+//! negative); it must be finite. Network evaluations run in parallel on
+//! [`rayon`] (the current pool: `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(|| esp.run(..))`
+//! chooses the thread count); every random draw comes from a
+//! counter-based stream ([`rng`]) keyed by what it is for (seed,
+//! generation, network, ...), so a run is bit-identical for any thread
+//! count.
 //!
 //! ```
 //! use esp_neuroevolution::network::Network;
@@ -19,7 +23,7 @@
 //!     let mut out = [0.0];
 //!     let mut error = 0.0;
 //!     for x in [0.0, 0.25, 0.5, 0.75, 1.0] {
-//!         net.activate(&[x, 1.0], &mut out);
+//!         net.try_activate(&[x, 1.0], &mut out)?; // a wrong length is an error, not a panic
 //!         error += (out[0] - x).powi(2);
 //!     }
 //!     Ok(-error)
@@ -31,30 +35,54 @@
 //!
 //! A run can also be driven from outside, by ask and tell ([`AskTell`]):
 //! [`Esp::start`] and [`HillClimb::start`] make runs that ask for networks
-//! and are told their fitness; [`lockstep`] advances many such runs
-//! together, evaluating every round's networks of all of them in one batch.
-//! Either way a run is the one [`Esp::run`] gives, bit for bit.
+//! and are told their fitness with the ask's [`Ticket`]; [`lockstep`]
+//! advances many such runs together, evaluating every round's networks of
+//! all of them in one batch. Either way a run is the one [`Esp::run`]
+//! gives, bit for bit. A run under way ([`EspRun`], [`HillClimbRun`],
+//! [`AnyRun`]) is serde as a whole: saved at any point and restored, it
+//! ends as the run never stopped would have; so are its
+//! [`Network`](network::Network)s, [`Champion`] and [`RunResult`].
+//!
+//! [`progress`] is a ready-made per-generation callback; [`limits`] holds
+//! every setting's bounds.
 
+mod any_run;
 mod ask;
 mod error;
 mod esp;
-mod esp_run;
 mod evaluator;
 mod hill_climb;
+pub mod limits;
 pub mod lockstep;
 pub mod math;
 pub mod network;
 pub mod operators;
+mod progress;
 mod record;
 pub mod rng;
+mod run;
 mod subpop;
 
-pub use ask::{AskPurpose, AskTell, Asked};
+pub use any_run::AnyRun;
+pub use ask::{AskPurpose, AskTell, Asked, Ticket};
 pub use error::{RunError, SettingsError};
-pub use esp::{BurstMode, Credit, Esp, EspSettings, Sampling, StagnationRule, TopologyMode};
-pub use esp_run::EspRun;
+pub use esp::{BurstMode, Credit, Esp, EspRun, EspSettings, Sampling, StagnationRule, TopologyMode};
 pub use evaluator::{evaluate_all, evaluate_each, evaluate_each_part, Evaluator, FnEvaluator, Part};
 pub use hill_climb::{HillClimb, HillClimbRun, HillClimbSettings, MutationRates};
+pub use limits::{
+    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_REAL_SETTING, MAX_SUBPOP_SIZE, MAX_TRIALS_PER_NEURON,
+    MIN_CAUCHY_LIMIT_PER_SCALE, MIN_SUBPOP_SIZE,
+};
+pub use progress::progress;
+/// The random number crate whose traits draw from a [`rng::Stream`]
+/// (`use esp_neuroevolution::rand::RngExt;` then `rng.random::<f64>()`),
+/// re-exported so that an evaluator uses the version the streams implement.
+pub use rand;
+/// The thread pool crate the evaluations run on, re-exported for choosing
+/// a run's thread count:
+/// `rayon::ThreadPoolBuilder::new().num_threads(4).build()?.install(|| esp.run(&evaluator, |_| {}))`.
+/// A run is bit-identical on any number of threads.
+pub use rayon;
 pub use record::{Champion, Control, Ending, GenerationRecord, LesionOutcome, RunResult, StopAt};
 
 /// Records reserved at a run's start: at most its generations, which may
@@ -79,94 +107,6 @@ pub(crate) mod purpose {
     pub const NEW_SUBPOP: u64 = 7;
     /// Hill-climber mutations.
     pub const MUTATE: u64 = 8;
-}
-
-/// Checks a probability setting.
-pub(crate) fn check_probability(name: &'static str, value: f64) -> Result<(), SettingsError> {
-    if (0.0..=1.0).contains(&value) {
-        Ok(())
-    } else {
-        Err(SettingsError::NotAProbability { name, value })
-    }
-}
-
-/// The largest initial weight range, Cauchy scale, Cauchy limit or
-/// annealing constant: the paper's are 0.3-10. Weights stay within
-/// [`MAX_REAL_SETTING`] times the generations of a run, so that a network's
-/// sums stay finite.
-pub const MAX_REAL_SETTING: f64 = 1e6;
-
-/// The most generations (ESP) or cycles (hill-climber) of a run (the paper:
-/// 2000); a run keeps one record per generation.
-pub const MAX_GENERATIONS: usize = 1_000_000;
-
-/// The most neurons per sub-population (the paper: 40).
-pub const MAX_SUBPOP_SIZE: usize = 10_000;
-
-/// The most evaluations per neuron and generation (the paper: 10).
-pub const MAX_TRIALS_PER_NEURON: usize = 1_000;
-
-/// The most hidden neurons a run starts with (the paper: 5).
-pub const MAX_HIDDEN: usize = 100;
-
-/// The most networks evaluated per generation (ESP: `trials_per_neuron`
-/// x `subpop_size`; the hill-climber: `candidates`; the paper: 400). A
-/// generation holds them all: at [`MAX_HIDDEN`] neurons of a 7-input,
-/// 4-output network that is about 1 GB.
-pub const MAX_NETWORKS_PER_GENERATION: usize = 100_000;
-
-/// The smallest Cauchy limit, as a multiple of the largest Cauchy scale of
-/// a run. A draw `alpha tan(pi u)` is accepted with probability
-/// `(2 / pi) atan(limit / alpha)`: at least 6.3 % at this ratio, so the
-/// rejection loop ends (the paper's 10 / 0.3 accepts 98 %).
-pub const MIN_CAUCHY_LIMIT_PER_SCALE: f64 = 0.1;
-
-/// Checks a setting in (0, [`MAX_REAL_SETTING`]].
-pub(crate) fn check_positive(name: &'static str, value: f64) -> Result<(), SettingsError> {
-    if !(value.is_finite() && value > 0.0) {
-        Err(SettingsError::NotPositive { name, value })
-    } else if value > MAX_REAL_SETTING {
-        Err(SettingsError::TooLarge {
-            name,
-            value,
-            max: MAX_REAL_SETTING,
-        })
-    } else {
-        Ok(())
-    }
-}
-
-/// Checks a count setting in [min, max].
-pub(crate) fn check_count(name: &'static str, value: usize, min: usize, max: usize) -> Result<(), SettingsError> {
-    if value < min {
-        Err(SettingsError::TooFew { name, value, min })
-    } else if value > max {
-        Err(SettingsError::TooMany { name, value, max })
-    } else {
-        Ok(())
-    }
-}
-
-/// Checks that `limit_name` (a Cauchy limit) is at least
-/// [`MIN_CAUCHY_LIMIT_PER_SCALE`] times `largest_scale`, the largest Cauchy
-/// scale the run draws with (described by `scale_name`).
-pub(crate) fn check_cauchy_limit(
-    limit_name: &'static str,
-    limit: f64,
-    scale_name: &'static str,
-    largest_scale: f64,
-) -> Result<(), SettingsError> {
-    if limit >= MIN_CAUCHY_LIMIT_PER_SCALE * largest_scale {
-        Ok(())
-    } else {
-        Err(SettingsError::CauchyLimitTooSmall {
-            limit_name,
-            limit,
-            scale_name,
-            scale: largest_scale,
-            ratio: MIN_CAUCHY_LIMIT_PER_SCALE,
-        })
-    }
 }
 
 /// The first position of the highest fitness, and that fitness.

@@ -190,10 +190,29 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
     evaluators: &[&E],
     on_record: impl Fn(usize, &GenerationRecord) -> Control + Sync,
 ) -> Vec<Option<RunError>> {
+    lockstep_with(runs, evaluators, on_record, |_, _| {})
+}
+
+/// [`lockstep`], calling `after_round(round, runs)` after every round
+/// (from 1) with all the runs as they stand: the place to save them
+/// (serde: [`AnyRun`](crate::AnyRun), [`EspRun`](crate::EspRun)), so that
+/// runs killed with their process resume, restored, where the last save
+/// left them, each still bit-identical to its own run.
+///
+/// # Panics
+/// If `evaluators` and `runs` differ in length.
+pub fn lockstep_with<R: AskTell + Send, E: Evaluator>(
+    runs: &mut [R],
+    evaluators: &[&E],
+    on_record: impl Fn(usize, &GenerationRecord) -> Control + Sync,
+    mut after_round: impl FnMut(usize, &[R]),
+) -> Vec<Option<RunError>> {
     assert_eq!(runs.len(), evaluators.len(), "one evaluator per run");
     let mut failed: Vec<Option<RunError>> = runs.iter().map(|_| None).collect();
     let mut live: Vec<bool> = vec![true; runs.len()];
+    let mut round = 0;
     while live.iter().any(|&l| l) {
+        round += 1;
         let asked: Vec<_> = runs
             .par_iter_mut()
             .zip(&live)
@@ -201,10 +220,12 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
             .collect();
         let mut owners = Vec::new();
         let mut jobs = Vec::new();
+        let mut tickets = vec![None; live.len()];
         for (i, asked) in asked.iter().enumerate() {
             match asked {
                 Some(Ok(Some(asked))) => {
                     owners.push(i);
+                    tickets[i] = Some(asked.ticket());
                     jobs.push(Job {
                         evaluator: evaluators[i],
                         networks: asked,
@@ -228,11 +249,11 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
         }
         let told: Vec<Option<RunError>> = runs
             .par_iter_mut()
-            .zip(fitness)
+            .zip(fitness.into_par_iter().zip(tickets))
             .enumerate()
-            .map(|(i, (run, fitness))| {
-                let fitness = fitness?;
-                let result = fitness.and_then(|fitness| run.tell(&fitness).map(|record| record.cloned()));
+            .map(|(i, (run, (fitness, ticket)))| {
+                let (fitness, ticket) = (fitness?, ticket?);
+                let result = fitness.and_then(|fitness| run.tell(ticket, &fitness).map(|record| record.cloned()));
                 match result {
                     Ok(Some(record)) => {
                         if on_record(i, &record) == Control::Stop {
@@ -251,6 +272,7 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
                 live[i] = false;
             }
         }
+        after_round(round, runs);
     }
     failed
 }

@@ -8,8 +8,10 @@
 
 use std::borrow::{Borrow, Cow};
 
-use crate::math::{sigmoid_with, Exponential};
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
+
+use crate::math::{sigmoid_with, Exponential};
 
 /// Errors building a network.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -17,6 +19,16 @@ pub enum NetworkError {
     /// A size is zero or the genes do not fit the sizes.
     #[error("network shape: {0}")]
     Shape(String),
+    /// An input or output slice of another length than the network's.
+    #[error("the network has {expected} {what}, got {got}")]
+    Length {
+        /// "inputs" or "outputs".
+        what: &'static str,
+        /// The network's count.
+        expected: usize,
+        /// The slice's length.
+        got: usize,
+    },
     /// A weight is NaN or infinite.
     #[error("weight {index} of hidden neuron {neuron} is not finite ({value})")]
     NonFinite {
@@ -109,12 +121,43 @@ impl<N: Borrow<Network> + Sync> NetworkSet for [N] {
 }
 
 /// A 1-hidden-layer network; see the module docs for the gene layout.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// Serde writes its sizes, genes and lesioned neurons, and checks them when
+/// it reads one back (as [`Network::from_genes`] does).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "NetworkData")]
 pub struct Network {
     inputs: usize,
     outputs: usize,
     genes: Vec<f64>,
     lesioned: Vec<bool>,
+}
+
+/// A network as serde reads it, before its check.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct NetworkData {
+    inputs: usize,
+    outputs: usize,
+    genes: Vec<f64>,
+    lesioned: Vec<bool>,
+}
+
+impl TryFrom<NetworkData> for Network {
+    type Error = NetworkError;
+
+    fn try_from(data: NetworkData) -> Result<Network, NetworkError> {
+        let mut network = Network::from_genes(data.inputs, data.outputs, data.genes)?;
+        if data.lesioned.len() != network.hidden() {
+            return Err(NetworkError::Shape(format!(
+                "{} lesion flags for {} hidden neurons",
+                data.lesioned.len(),
+                network.hidden()
+            )));
+        }
+        network.lesioned = data.lesioned;
+        Ok(network)
+    }
 }
 
 impl Network {
@@ -211,6 +254,25 @@ impl Network {
     #[inline(always)]
     pub fn activate(&self, input: &[f64], output: &mut [f64]) {
         self.activate_with(Exponential::default(), input, output);
+    }
+
+    /// [`Network::activate`], with an error instead of a panic when the
+    /// slices' lengths differ from the network's inputs and outputs: what
+    /// an evaluator that builds its inputs itself should call, so that a
+    /// mistake there is a [`RunError::Evaluation`](crate::RunError::Evaluation)
+    /// naming the lengths (through `?`) rather than a panic in every
+    /// thread.
+    pub fn try_activate(&self, input: &[f64], output: &mut [f64]) -> Result<(), NetworkError> {
+        for (what, expected, got) in [
+            ("inputs", self.inputs, input.len()),
+            ("outputs", self.outputs, output.len()),
+        ] {
+            if expected != got {
+                return Err(NetworkError::Length { what, expected, got });
+            }
+        }
+        self.activate(input, output);
+        Ok(())
     }
 
     /// [`Network::activate`] with the logistic units' exponential

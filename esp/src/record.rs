@@ -2,7 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::limits::check_finite;
 use crate::network::Network;
+use crate::SettingsError;
 
 /// The outcome of a lesion test.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -47,7 +49,7 @@ pub struct GenerationRecord {
 }
 
 /// The best network ever evaluated.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Champion {
     /// The network.
     pub network: Network,
@@ -62,7 +64,7 @@ pub struct Champion {
 }
 
 /// The outcome of a run.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunResult {
     /// The champion.
     pub champion: Champion,
@@ -114,9 +116,10 @@ pub enum Ending {
 /// generation (cycle). A generation is never cut short: a run that reaches
 /// its budget in the middle of a generation finishes it (and its lesion
 /// test), and its result says exactly how many evaluations it spent.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct StopAt {
-    /// End once the champion's fitness is at least this.
+    /// End once the champion's fitness is at least this. Must be finite
+    /// ([`StopAt::validate`]).
     pub goal: Option<f64>,
     /// End once at least this many networks have been evaluated.
     pub evaluations: Option<u64>,
@@ -128,6 +131,12 @@ impl StopAt {
         goal: None,
         evaluations: None,
     };
+
+    /// Rejects a goal that is NaN or infinite (a run would never, or
+    /// always, reach it). Runs check their stop conditions when they start.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        self.goal.map_or(Ok(()), |goal| check_finite("stop.goal", goal))
+    }
 
     /// The decision after the generation that `record` describes, given
     /// the callback's: why the run ends there, if it does.

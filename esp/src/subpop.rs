@@ -1,15 +1,21 @@
 //! A sub-population of ESP: neurons of equal length stored neuron after
 //! neuron in one array, so that the whole sub-population is checked for
 //! non-finite weights in one vectorised pass per generation and the
-//! networks assembled from it need no check of their own.
+//! networks assembled from it need no check of their own; and the networks
+//! a generation forms from the sub-populations, read in place.
 
-use super::operators::random_genes;
+use std::borrow::Cow;
+
+use serde::{Deserialize, Serialize};
+
+use crate::network::{Network, NetworkSet};
+use crate::operators::random_genes;
 use crate::rng::Stream;
 
 /// `len()` neurons of `genes_per_neuron` genes each, neuron k at
 /// `genes[k * per..(k + 1) * per]`.
-#[derive(Debug, Clone, PartialEq)]
-pub(super) struct Subpop {
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct Subpop {
     per: usize,
     genes: Vec<f64>,
 }
@@ -43,6 +49,12 @@ impl Subpop {
     /// Genes per neuron.
     pub fn genes_per_neuron(&self) -> usize {
         self.per
+    }
+
+    /// Whether the genes make whole neurons of at least one gene (a
+    /// restored sub-population's check).
+    pub fn is_whole(&self) -> bool {
+        self.per > 0 && self.genes.len() % self.per == 0
     }
 
     /// Neuron `k`'s genes.
@@ -80,6 +92,64 @@ impl Subpop {
             genes.extend_from_slice(self.neuron(k));
         }
         self.genes = genes;
+    }
+}
+
+/// Which neuron of each sub-population every network of a generation
+/// takes, network after network in one flat list: network j takes neuron
+/// `flat[j * subpops + i]` of sub-population i.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct Picks {
+    pub(crate) subpops: usize,
+    pub(crate) flat: Vec<usize>,
+}
+
+impl Picks {
+    /// The number of networks.
+    pub fn count(&self) -> usize {
+        self.flat.len() / self.subpops
+    }
+
+    /// Each network's picks, one per sub-population.
+    pub fn networks(&self) -> std::slice::ChunksExact<'_, usize> {
+        self.flat.chunks_exact(self.subpops)
+    }
+}
+
+/// A generation's networks as its sub-populations and picks: what the
+/// evaluator reads, neuron by neuron, without a copy of each network.
+pub(crate) struct Assembled<'a> {
+    pub(crate) inputs: usize,
+    pub(crate) outputs: usize,
+    pub(crate) subpops: &'a [Subpop],
+    pub(crate) picks: &'a Picks,
+}
+
+impl NetworkSet for Assembled<'_> {
+    fn len(&self) -> usize {
+        self.picks.count()
+    }
+    fn shape(&self, _: usize) -> (usize, usize) {
+        (self.inputs, self.outputs)
+    }
+    fn hidden(&self, _: usize) -> usize {
+        self.subpops.len()
+    }
+    fn neuron(&self, j: usize, k: usize) -> &[f64] {
+        self.subpops[k].neuron(self.picks.flat[j * self.picks.subpops + k])
+    }
+    fn is_lesioned(&self, _: usize, _: usize) -> bool {
+        false
+    }
+    fn network(&self, j: usize) -> Cow<'_, Network> {
+        let genes = (0..self.subpops.len())
+            .flat_map(|k| self.neuron(j, k))
+            .copied()
+            .collect();
+        Cow::Owned(
+            Network::from_genes(self.inputs, self.outputs, genes)
+                .expect("the sub-populations' weights were checked finite and their shape fits"),
+        )
     }
 }
 

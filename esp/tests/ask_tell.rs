@@ -8,44 +8,11 @@ use esp_neuroevolution::{
     evaluate_all, evaluate_each_part, AskPurpose, AskTell, Control, Ending, Esp, EspSettings, Evaluator, FnEvaluator,
     GenerationRecord, HillClimb, HillClimbSettings, Part, RunError, RunResult, StopAt, TopologyMode,
 };
-use rand::RngExt;
 
-/// A noisy function to fit: output 0 should be x^2 at 8 points x in [0, 1]
-/// drawn from the evaluation's stream (inputs x and a bias), so a network
-/// evaluated with another stream scores differently; the error is
-/// rounded to steps of 0.25, so the search stagnates often.
-fn problem() -> impl Evaluator<Worker = ()> {
-    FnEvaluator::new(2, 1, |net: &Network, rng: &mut Stream| {
-        let mut out = [0.0];
-        let mut error = 0.0;
-        for _ in 0..8 {
-            let x: f64 = rng.random();
-            net.activate(&[x, 1.0], &mut out);
-            error += (out[0] - x * x).powi(2);
-        }
-        Ok(-(error * 4.0).round() / 4.0)
-    })
-}
+mod common;
 
-/// Settings that stagnate often: bursts and lesion tests (both kinds for
-/// discard-all) within a few dozen generations.
-fn small(settings: EspSettings) -> EspSettings {
-    EspSettings {
-        subpop_size: 8,
-        trials_per_neuron: 2,
-        initial_hidden: 2,
-        generations: 80,
-        stagnation: 3,
-        bursts_before_lesion: 1,
-        ..settings
-    }
-}
-
-/// Every bit of a result: records, ending and champion (Debug prints
-/// every f64 exactly).
-fn bits(result: &RunResult) -> String {
-    format!("{:?} {:?} {:?}", result.records, result.ending, result.champion)
-}
+use common::{bits, problem, small};
+use esp_neuroevolution::rand::RngExt;
 
 /// Drives `run` by hand: each asked network evaluated one by one with its
 /// stream, on this thread; returns the result and the purposes asked.
@@ -58,7 +25,7 @@ fn by_hand<R: AskTell, E: Evaluator>(
     let mut purposes = Vec::new();
     while let Some(asked) = run.ask().unwrap() {
         purposes.push(asked.purpose());
-        let streams = asked.streams();
+        let (ticket, streams) = (asked.ticket(), asked.streams());
         let fitness: Vec<f64> = (0..asked.len())
             .map(|j| {
                 evaluator
@@ -66,7 +33,7 @@ fn by_hand<R: AskTell, E: Evaluator>(
                     .unwrap()
             })
             .collect();
-        if let Some(record) = run.tell(&fitness).unwrap() {
+        if let Some(record) = run.tell(ticket, &fitness).unwrap() {
             if stop_after(record) {
                 run.stop();
             }
@@ -179,8 +146,8 @@ fn a_wrong_tell_is_a_typed_error_that_leaves_the_run_as_it_was() {
     assert!(matches!(run.result(), Err(RunError::NotEnded)));
     let asked = run.ask().unwrap().expect("a new run asks");
     assert_eq!((asked.purpose(), asked.len()), (AskPurpose::Generation(1), 16));
-    let fitness = asked.evaluate(&evaluator).unwrap();
-    let error = run.tell(&fitness[1..]).unwrap_err();
+    let (ticket, fitness) = (asked.ticket(), asked.evaluate(&evaluator).unwrap());
+    let error = run.tell(ticket, &fitness[1..]).unwrap_err();
     assert!(
         matches!(error, RunError::FitnessCount { expected: 16, got: 15 }),
         "{error:?}"
@@ -189,16 +156,36 @@ fn a_wrong_tell_is_a_typed_error_that_leaves_the_run_as_it_was() {
     let mut with_nan = fitness.clone();
     with_nan[4] = f64::NAN;
     assert!(matches!(
-        run.tell(&with_nan).unwrap_err(),
+        run.tell(ticket, &with_nan).unwrap_err(),
         RunError::NanFitness { network: 4 }
     ));
-    // Asking again asks for the same networks; the run goes on unharmed.
+    let mut with_infinity = fitness.clone();
+    with_infinity[7] = f64::INFINITY;
+    assert!(matches!(
+        run.tell(ticket, &with_infinity).unwrap_err(),
+        RunError::InfiniteFitness { network: 7, .. }
+    ));
+    // Another run's ticket, even of the same settings and ask, is refused.
+    let mut twin = esp.start(2, 1).unwrap();
+    let twin_ticket = twin.ask().unwrap().unwrap().ticket();
+    assert!(matches!(
+        run.tell(twin_ticket, &fitness).unwrap_err(),
+        RunError::ForeignTicket
+    ));
+    // Asking again asks for the same networks, under the same ticket; the run goes on unharmed.
     let again = run.ask().unwrap().unwrap();
+    assert_eq!(again.ticket(), ticket);
     assert_eq!(again.evaluate(&evaluator).unwrap(), fitness);
-    assert_eq!(run.tell(&fitness).unwrap().unwrap().generation, 1);
+    assert_eq!(run.tell(ticket, &fitness).unwrap().unwrap().generation, 1);
+    // The same ticket twice (or a tell with no ask since the last) is refused.
+    let error = run.tell(ticket, &fitness).unwrap_err();
+    assert!(
+        matches!(error, RunError::TicketTold { ticket: 0, told: 1 }),
+        "{error:?}"
+    );
     let (got, _) = by_hand(&mut run, &evaluator, |_| false);
     assert_eq!(bits(&got), bits(&expected));
-    assert!(matches!(run.tell(&fitness).unwrap_err(), RunError::Ended));
+    assert!(matches!(run.tell(ticket, &fitness).unwrap_err(), RunError::Ended));
     assert_eq!(bits(&run.into_result().unwrap()), bits(&expected));
     // A run on networks without inputs cannot start.
     assert!(matches!(esp.start(0, 1), Err(RunError::Network(_))));
