@@ -435,6 +435,93 @@ mod tests {
     }
 
     #[test]
+    fn every_reading_of_the_fitness_and_the_inputs_can_be_varied() {
+        use crate::psa::{FitnessKind, FitnessState, HeadingInput, HeadingWrap, Scoring, Task};
+        let vary = [
+            "problem.fitness.kind=incremental,original",
+            "problem.fitness.scoring=evolution,original",
+            "problem.fitness.state=truth,sensed",
+            "problem.sensors.heading_input=error,absolute",
+            "problem.sensors.heading_wrap=symmetric,positive",
+            "problem.noise.on_bias=false,true",
+            "problem.task3.fitness=original",
+            "problem.task3.scoring=incremental",
+            "problem.task2.steps=2000",
+        ];
+        let s = SweepSpec::new(
+            GridSpec::from_preset(GridPreset::Quick),
+            vary.iter().map(|v| parse_vary(v).unwrap()).collect(),
+            SweepMode::OneAtATime,
+        )
+        .unwrap();
+        // The base, then the second value of each two-valued setting and the single ones.
+        let problem = |i: usize| {
+            let variants = s.variants();
+            let grid = s.variant_grid(&variants[i]).unwrap();
+            grid.run_config(crate::experiment::GridConfig::Preset(
+                crate::experiment::Preset::Baseline,
+            ))
+            .unwrap()
+            .problem
+        };
+        let variants = s.variants();
+        let at = |setting: &str| {
+            let (key, value) = setting.split_once('=').unwrap();
+            variants
+                .iter()
+                .position(|v| {
+                    v.settings
+                        .first()
+                        .is_some_and(|(k, v)| k == key && v.trim_matches('"') == value)
+                })
+                .unwrap_or_else(|| panic!("no variant {setting}"))
+        };
+        assert_eq!(
+            problem(at("problem.fitness.kind=original")).fitness.kind,
+            FitnessKind::Original
+        );
+        assert_eq!(
+            problem(at("problem.fitness.scoring=original")).fitness.scoring,
+            Scoring::Original
+        );
+        assert_eq!(
+            problem(at("problem.fitness.state=sensed")).fitness.state,
+            FitnessState::Sensed
+        );
+        assert_eq!(
+            problem(at("problem.sensors.heading_input=absolute"))
+                .sensors
+                .heading_input,
+            HeadingInput::Absolute
+        );
+        assert_eq!(
+            problem(at("problem.sensors.heading_wrap=positive"))
+                .sensors
+                .heading_wrap,
+            HeadingWrap::Positive
+        );
+        assert!(problem(at("problem.noise.on_bias=true")).noise.on_bias);
+        let task3 = problem(at("problem.task3.fitness=original"));
+        assert_eq!(
+            task3.for_task(Task::StopAtPosition).unwrap().fitness.kind,
+            FitnessKind::Original
+        );
+        assert_eq!(
+            task3.for_task(Task::Turn).unwrap().fitness.kind,
+            FitnessKind::Incremental
+        );
+        assert!(problem(at("problem.task3.scoring=incremental")).task3.scoring == Some(Scoring::Incremental));
+        assert_eq!(
+            problem(at("problem.task2.steps=2000"))
+                .for_task(Task::Turn)
+                .unwrap()
+                .steps,
+            2000
+        );
+        assert_eq!(problem(0).fitness.state, FitnessState::default());
+    }
+
+    #[test]
     fn a_bad_key_or_value_is_named_before_anything_runs() {
         let grid = GridSpec::from_preset(GridPreset::Quick);
         let e = SweepSpec::new(

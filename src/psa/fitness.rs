@@ -55,8 +55,9 @@ impl Scoring {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum FitnessState {
-    /// The true position, heading and spin. `[chosen]` default
+    /// The true position, heading and spin (`"truth"`). `[chosen]` default
     #[default]
+    #[serde(rename = "truth", alias = "true")]
     True,
     /// The sensed ones: under input noise the fitness sees the noise too.
     Sensed,
@@ -83,7 +84,7 @@ pub struct FitnessSettings {
     /// What champions are scored with (Tables 1-7; per task with
     /// `problem.taskN.scoring`). `[chosen]` evolution
     pub scoring: Scoring,
-    /// Which state the fitness reads. `[chosen]` true
+    /// Which state the fitness reads: `truth` or `sensed`. `[chosen]` truth
     pub state: FitnessState,
 }
 
