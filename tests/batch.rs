@@ -219,8 +219,8 @@ fn the_batched_path_refuses_other_backends_and_bad_networks() {
 
 #[test]
 fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
+    use psa_esp::evaluator::PsaEvaluator;
     use psa_esp::evolution::{Esp, EspSettings};
-    use psa_esp::experiment::PsaEvaluator;
     let settings = native(PsaSettings::default());
     let esp = Esp::new(
         EspSettings {

@@ -226,8 +226,8 @@ fn a_fleet_checks_every_command_and_state_before_calling_ode() {
 
 #[test]
 fn an_esp_run_on_ode_is_the_same_in_lockstep_and_one_world_per_network_on_any_thread_count() {
+    use psa_esp::evaluator::PsaEvaluator;
     use psa_esp::evolution::{Esp, EspSettings};
-    use psa_esp::experiment::PsaEvaluator;
     let settings = PsaSettings {
         steps: 150,
         ..PsaSettings::default()

@@ -71,7 +71,7 @@ impl RunConfig {
 }
 
 /// One configuration of the paper.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Preset {
     /// ESP with burst mutation discarding all sub-populations (Table 1).

@@ -30,7 +30,7 @@ pub const GRID_VERSION: u32 = 1;
 pub const MAX_SEEDS: u64 = 10_000;
 
 /// Which protocol a grid follows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GridPreset {
     /// A reduced grid that finishes in about a minute on 2 cores.
@@ -38,6 +38,19 @@ pub enum GridPreset {
     /// The paper's full protocol: 2000 generations, 30 seeds, 500-trial
     /// robustness tests, on the `native` backend.
     Paper,
+}
+
+impl GridPreset {
+    /// Every preset.
+    pub const ALL: [GridPreset; 2] = [GridPreset::Quick, GridPreset::Paper];
+
+    /// The preset's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            GridPreset::Quick => "quick",
+            GridPreset::Paper => "paper",
+        }
+    }
 }
 
 /// A grid's definition, written to `grid.json`.

@@ -13,7 +13,8 @@ use rayon::prelude::*;
 
 use super::grid::{run_dir, GridSpec, RunKey};
 use super::replicate::{run_seed, test_and_mark, FinishedRun};
-use super::{Algorithm, GridConfig, PsaEvaluator, RunConfig, RunStart};
+use super::{Algorithm, GridConfig, RunConfig, RunStart};
+use crate::evaluator::PsaEvaluator;
 use crate::evolution::lockstep::lockstep;
 use crate::evolution::{AskTell, Control, Esp, HillClimb};
 use crate::psa::Task;

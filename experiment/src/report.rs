@@ -29,6 +29,7 @@ use super::robustness::Robustness;
 use super::runs_table::{runs_csv, RUNS_CSV};
 use super::GridConfig;
 use crate::physics::BackendKind;
+use crate::provenance::BuildInfo;
 use crate::psa::Task;
 
 pub use distance::{Distance, Term};
@@ -38,7 +39,7 @@ pub use sweep::{write_sweep_report, SweepReport};
 pub use tables::{BurstRow, FigureLink, MissingCell, Report, Row, Table};
 
 /// Which files `psa-esp report` writes besides `report.md`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ReportFormat {
     /// `report.md` only (the Markdown is also printed).
@@ -47,6 +48,20 @@ pub enum ReportFormat {
     Csv,
     /// `report.md` and `report.json` (the whole report).
     Json,
+}
+
+impl ReportFormat {
+    /// Every format.
+    pub const ALL: [ReportFormat; 3] = [ReportFormat::Md, ReportFormat::Csv, ReportFormat::Json];
+
+    /// The format's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReportFormat::Md => "md",
+            ReportFormat::Csv => "csv",
+            ReportFormat::Json => "json",
+        }
+    }
 }
 
 /// What a table row measures, per champion.
@@ -78,17 +93,6 @@ impl Metric {
     }
 }
 
-/// The build a run was made with (`run.json`'s `build`).
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub struct BuildRecord {
-    /// Crate version.
-    pub tool_version: String,
-    /// Git commit (`-dirty` with uncommitted changes).
-    pub git_commit: String,
-    /// libode version.
-    pub libode_version: String,
-}
-
 /// The fields of `run.json` the report reads.
 #[derive(Debug, Deserialize)]
 struct RunSummary {
@@ -102,7 +106,7 @@ struct RunSummary {
     bursts: usize,
     champion_hidden: usize,
     seconds: f64,
-    build: BuildRecord,
+    build: BuildInfo,
 }
 
 /// One generation of `records.csv` (the columns the report uses), fitness in %.
@@ -142,7 +146,7 @@ pub struct RunData {
     /// Wall-clock seconds.
     pub seconds: f64,
     /// The build that made it.
-    pub build: BuildRecord,
+    pub build: BuildInfo,
     /// The robustness tests of its champion.
     pub robustness: Robustness,
     /// One row per generation.

@@ -7,7 +7,8 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use serde::Serialize;
 
-use super::{Algorithm, PsaEvaluator, RunConfig};
+use super::{Algorithm, RunConfig};
+use crate::evaluator::PsaEvaluator;
 use crate::evolution::{Esp, GenerationRecord, HillClimb, RunResult};
 use crate::io::write_atomic;
 use crate::psa::{NetworkFile, Task};
@@ -219,7 +220,8 @@ impl RunStart {
         extra.insert("fitness_percent".into(), champion.fitness.into());
         extra.insert("generation".into(), champion.generation.into());
         extra.insert("backend".into(), config.problem.backend.name().into());
-        NetworkFile::new(&champion.network, task, &config.problem, extra).save(&files.champion)?;
+        let build = crate::build_info();
+        NetworkFile::new(&champion.network, task, &config.problem, &build, extra).save(&files.champion)?;
         let last = result.records.last().context("a run has at least one generation")?;
         let outcome = EvolveOutcome {
             task,
@@ -232,7 +234,7 @@ impl RunStart {
             evaluations: last.evaluations,
             bursts: last.bursts,
             champion_hidden: champion.network.hidden(),
-            build: crate::provenance::build_info(),
+            build,
             started: self.started,
             finished: crate::provenance::now_rfc3339(),
             seconds,

@@ -36,13 +36,26 @@ pub struct Vary {
 }
 
 /// How the varied settings combine.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SweepMode {
     /// Every combination of the values (the Cartesian product).
     Combinations,
     /// One setting at a time, the others at the base; plus the base itself.
     OneAtATime,
+}
+
+impl SweepMode {
+    /// Every mode.
+    pub const ALL: [SweepMode; 2] = [SweepMode::Combinations, SweepMode::OneAtATime];
+
+    /// The mode's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepMode::Combinations => "combinations",
+            SweepMode::OneAtATime => "one-at-a-time",
+        }
+    }
 }
 
 /// One variant: its name (its folder) and its settings.
@@ -382,7 +395,7 @@ fn prepare(dir: &Path, spec: &SweepSpec) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::grid::GridPreset;
+    use crate::grid::GridPreset;
 
     #[test]
     fn values_split_at_top_level_commas_and_read_as_toml() {
@@ -427,11 +440,11 @@ mod tests {
         s.grid.overrides = Some("[esp]\nsubpop_size = 20\n".into());
         let variants = s.variants();
         let grid = s.variant_grid(&variants[3]).unwrap();
-        let config = grid.run_config(crate::experiment::GridConfig::InputNoise).unwrap();
+        let config = grid.run_config(crate::GridConfig::InputNoise).unwrap();
         assert_eq!(config.esp.subpop_size, 20);
         assert_eq!(config.esp.stagnation, 40);
         assert_eq!(config.problem.tasks.task3_speed, 0.1);
-        assert_eq!(config.problem.noise.input_sd, crate::experiment::PAPER_NOISE_SD);
+        assert_eq!(config.problem.noise.input_sd, crate::PAPER_NOISE_SD);
     }
 
     #[test]

@@ -1,37 +1,20 @@
-//! Where a result came from: tool version, git commit and libode version,
-//! stamped into the binary by `build.rs`.
+//! Where a result came from: the build's identity as every result file
+//! records it, this host's name and the time. The git commit is stamped
+//! one crate up, by `psa-experiment` (`psa_experiment::build_info`), so
+//! that a commit never recompiles the simulator.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-/// The build's identity, recorded in every result file.
-#[derive(Debug, Clone, Serialize)]
+/// The build's identity, recorded in every result file (`run.json`'s
+/// `build`, a network file's `provenance`).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct BuildInfo {
     /// The crate version.
-    pub tool_version: &'static str,
+    pub tool_version: String,
     /// The git commit of the build (`-dirty` when it had uncommitted changes).
-    pub git_commit: &'static str,
+    pub git_commit: String,
     /// The libode version `ode-sys` was built against.
-    pub libode_version: &'static str,
-}
-
-/// What `psa-esp --version` prints after the name: the crate version, the
-/// commit and the libode version.
-pub const VERSION: &str = concat!(
-    env!("CARGO_PKG_VERSION"),
-    " (commit ",
-    env!("PSA_ESP_GIT_COMMIT"),
-    ", libode ",
-    env!("PSA_ESP_LIBODE_VERSION"),
-    ")"
-);
-
-/// This binary's build identity.
-pub fn build_info() -> BuildInfo {
-    BuildInfo {
-        tool_version: env!("CARGO_PKG_VERSION"),
-        git_commit: env!("PSA_ESP_GIT_COMMIT"),
-        libode_version: env!("PSA_ESP_LIBODE_VERSION"),
-    }
+    pub libode_version: String,
 }
 
 /// The current UTC time as RFC 3339, to the second.

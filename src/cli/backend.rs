@@ -4,7 +4,7 @@
 use anyhow::Result;
 use std::sync::Arc;
 
-use crate::experiment::fly_trials_on;
+use crate::evaluator::fly_trials_on;
 use crate::physics::BackendKind;
 use crate::psa::cuda::CudaTrials;
 

@@ -16,9 +16,9 @@ use serde::Serialize;
 
 use super::bench_kernel::{kernel_rows, KERNEL_NETWORKS};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
+use crate::evaluator::PsaEvaluator;
 use crate::evolution::evaluate_all;
 use crate::evolution::operators::random_genes;
-use crate::experiment::PsaEvaluator;
 use crate::network::Network;
 use crate::numeric::{sigmoid, Lanes, SimdLevel};
 use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};

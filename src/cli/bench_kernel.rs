@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::bench::random_networks;
 use super::bench_runs::median;
-use crate::experiment::{KERNEL_ON_HOST, SIMD_VARIABLE};
+use crate::evaluator::{KERNEL_ON_HOST, SIMD_VARIABLE};
 use crate::network::Network;
 use crate::physics::{BackendKind, PlanarBody};
 use crate::psa::cuda::{prepare, CudaTrials, HostTrials, TrialFlier};

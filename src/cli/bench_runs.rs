@@ -9,10 +9,11 @@ use std::time::Instant;
 use anyhow::Result;
 use serde::Serialize;
 
+use crate::evaluator::PsaEvaluator;
 use crate::evolution::{Esp, Evaluator};
 use crate::experiment::grid::{GridPreset, GridSpec};
 use crate::experiment::replicate::{replicate, FinishedRun, GridProgress, ReplicateOptions};
-use crate::experiment::{GridConfig, Preset, PsaEvaluator, RunConfig};
+use crate::experiment::{GridConfig, Preset, RunConfig};
 use crate::network::{Network, NetworkSet};
 use crate::physics::BackendKind;
 use crate::psa::Task;

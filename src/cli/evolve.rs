@@ -6,6 +6,7 @@ use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::backend::BackendArg;
+use super::choice::choice;
 use crate::experiment::{run_evolution, Preset};
 use crate::ode::MAX_THREADS;
 use crate::psa::Task;
@@ -17,7 +18,7 @@ pub struct EvolveArgs {
     #[arg(long)]
     pub task: Task,
     /// The paper's configuration to start from.
-    #[arg(long, value_enum, default_value_t = Preset::Baseline)]
+    #[arg(long, value_parser = choice(&Preset::ALL, Preset::name), default_value_t = Preset::Baseline)]
     pub preset: Preset,
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 
 use super::backend::BackendArg;
+use super::choice::choice;
 use super::evolve::progress_bar;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
@@ -37,7 +38,7 @@ pub struct GridArgs {
     /// quick: a reduced grid (5 seeds, 80 generations, 100-trial robustness,
     /// native backend; about a minute on 2 cores); paper: the full protocol
     /// (30 seeds, 2000 generations, 500-trial robustness, native backend).
-    #[arg(long, value_enum, default_value_t = GridPreset::Quick)]
+    #[arg(long, value_parser = choice(&GridPreset::ALL, GridPreset::name), default_value = GridPreset::Quick.name())]
     pub preset: GridPreset,
     /// Configurations, comma-separated (default: the paper's baseline,
     /// systematic, max-credit, lesion-off, erase-best, hill-climb,

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
+use super::choice::choice;
 use super::replicate::{report_held, GridArgs, Progress};
 use crate::experiment::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
 
@@ -17,7 +18,7 @@ pub struct SweepArgs {
     pub vary: Vec<String>,
     /// combinations: every combination of the values; one-at-a-time: each
     /// setting alone (the others at the base), plus the base.
-    #[arg(long, value_enum, default_value_t = SweepMode::Combinations)]
+    #[arg(long, value_parser = choice(&SweepMode::ALL, SweepMode::name), default_value = SweepMode::Combinations.name())]
     pub mode: SweepMode,
     /// The grid each variant runs.
     #[command(flatten)]

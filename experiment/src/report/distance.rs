@@ -14,8 +14,8 @@ use serde::Serialize;
 
 use super::paper::{paper_bursts, paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK};
 use super::{GridResults, Metric};
-use crate::experiment::{GridConfig, Preset};
 use crate::psa::Task;
+use crate::{GridConfig, Preset};
 
 /// One term of the distance.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -6,10 +6,10 @@ use std::path::{Path, PathBuf};
 
 use super::tables::FigureLink;
 use super::{GenerationRow, GridResults};
-use crate::experiment::stats::mean_sd;
-use crate::experiment::{Algorithm, GridConfig, Preset};
 use crate::plots::curves::{write_curve_figure, CurveFigure, Series};
 use crate::psa::Task;
+use crate::stats::mean_sd;
+use crate::{Algorithm, GridConfig, Preset};
 
 const Y_DESC: &str = "fitness (% of theoretical maximum)";
 

@@ -6,9 +6,9 @@ use serde::Serialize;
 use super::paper::{paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK};
 use super::tables::paper_bursts_per_run;
 use super::{GridResults, Metric};
-use crate::experiment::stats::{mean_sd, welch};
-use crate::experiment::{GridConfig, Preset};
 use crate::psa::Task;
+use crate::stats::{mean_sd, welch};
+use crate::{GridConfig, Preset};
 
 /// Significance level of the Welch rules.
 pub const ALPHA: f64 = 0.05;

@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use super::Metric;
-use crate::experiment::{GridConfig, Preset};
+use crate::{GridConfig, Preset};
 
 /// One cell of a paper table.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -6,8 +6,8 @@ use super::distance::Distance;
 use super::findings::{Comparison, Finding, Rule, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
 use super::paper::PAPER_BURST_RUNS;
 use super::tables::{Report, Table};
-use crate::experiment::grid::{GridPreset, GridSpec};
-use crate::experiment::PAPER_NOISE_SD;
+use crate::grid::{GridPreset, GridSpec};
+use crate::PAPER_NOISE_SD;
 
 /// A mean or sd with one decimal; "–" when undefined.
 pub(super) fn num(x: f64) -> String {

@@ -16,11 +16,11 @@ use super::findings::Verdict;
 use super::render::num;
 use super::tables::Report;
 use super::{GridResults, Metric};
-use crate::experiment::grid::grid_file;
-use crate::experiment::runs_table::{sweep_runs_csv, VariantRuns, RUNS_CSV};
-use crate::experiment::sweep::{variant_dir, SweepSpec};
-use crate::experiment::{GridConfig, Preset};
+use crate::grid::grid_file;
 use crate::psa::Task;
+use crate::runs_table::{sweep_runs_csv, VariantRuns, RUNS_CSV};
+use crate::sweep::{variant_dir, SweepSpec};
+use crate::{GridConfig, Preset};
 
 const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
 

@@ -8,11 +8,12 @@ use serde::Serialize;
 
 use super::findings::{findings, Finding};
 use super::paper::{paper_bursts, paper_cell, PaperCell, PAPER_BURST_RUNS};
-use super::{BuildRecord, GridResults, Metric, Problem};
-use crate::experiment::grid::{GridPreset, GridSpec, RunStatus};
-use crate::experiment::stats::{mean_sd, welch};
-use crate::experiment::{GridConfig, Preset};
+use super::{GridResults, Metric, Problem};
+use crate::grid::{GridPreset, GridSpec, RunStatus};
+use crate::provenance::BuildInfo;
 use crate::psa::Task;
+use crate::stats::{mean_sd, welch};
+use crate::{GridConfig, Preset};
 
 const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
 
@@ -97,7 +98,7 @@ pub struct FigureLink {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BuildCount {
     /// The build.
-    pub build: BuildRecord,
+    pub build: BuildInfo,
     /// Runs made with it.
     pub runs: usize,
 }
@@ -366,7 +367,7 @@ pub(super) fn reductions(spec: &GridSpec) -> Vec<String> {
 }
 
 fn builds(results: &GridResults) -> Vec<BuildCount> {
-    let mut counts: BTreeMap<&BuildRecord, usize> = BTreeMap::new();
+    let mut counts: BTreeMap<&BuildInfo, usize> = BTreeMap::new();
     for run in &results.runs {
         *counts.entry(&run.build).or_default() += 1;
     }

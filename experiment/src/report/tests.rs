@@ -3,12 +3,12 @@
 use std::path::{Path, PathBuf};
 
 use super::*;
-use crate::experiment::grid::{GridPreset, GridSpec};
-use crate::experiment::robustness::TrialSummary;
-use crate::experiment::Preset;
+use crate::grid::{GridPreset, GridSpec};
 use crate::network::Network;
 use crate::physics::BackendKind;
 use crate::psa::NetworkFile;
+use crate::robustness::TrialSummary;
+use crate::Preset;
 
 const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
 const MAX_CREDIT: GridConfig = GridConfig::Preset(Preset::MaxCredit);
@@ -56,9 +56,15 @@ fn write_run(dir: &Path, spec: &GridSpec, key: &RunKey) -> PathBuf {
     }
     std::fs::write(folder.join("records.csv"), csv).unwrap();
     let network = Network::from_neurons(5, 4, &[vec![0.25; 9], vec![-0.5; 9]]).unwrap();
-    NetworkFile::new(&network, key.task, &config.problem, serde_json::Map::new())
-        .save(&folder.join("champion.json"))
-        .unwrap();
+    NetworkFile::new(
+        &network,
+        key.task,
+        &config.problem,
+        &crate::build_info(),
+        serde_json::Map::new(),
+    )
+    .save(&folder.join("champion.json"))
+    .unwrap();
     let run = serde_json::json!({
         "task": key.task, "seed": 1234, "label": key.config.name(), "backend": "native",
         "champion_fitness": champion, "champion_generation": spec.generations, "generations": spec.generations,

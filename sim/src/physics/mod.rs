@@ -176,7 +176,7 @@ impl StepSettings {
 }
 
 /// Which physics engine simulates the body.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BackendKind {
     /// The Open Dynamics Engine through `ode-sys` (the faithful default).

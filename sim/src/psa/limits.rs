@@ -251,7 +251,7 @@ mod tests {
 
     #[test]
     fn the_documentation_lists_every_key() {
-        let doc = include_str!("../../docs/limits.md");
+        let doc = include_str!("../../../docs/limits.md");
         for l in LIMITS {
             assert!(doc.contains(&format!("`{}`", l.key)), "docs/limits.md lacks {}", l.key);
         }

@@ -26,6 +26,7 @@ use super::task::Task;
 use super::trial::PsaSettings;
 use crate::network::Network;
 use crate::numeric::Exponential;
+use crate::provenance::BuildInfo;
 
 /// The `format` field of every network file.
 pub const FORMAT: &str = "psa-esp-network";
@@ -95,20 +96,20 @@ pub struct NetworkFile {
 }
 
 impl NetworkFile {
-    /// A file for `network`, stamped with this build (tool version, git
+    /// A file for `network`, stamped with `build` (tool version, git
     /// commit, libode version); `extra` adds provenance fields. No time
     /// stamp, so that the same run always writes the same bytes.
     pub fn new(
         network: &Network,
         task: Task,
         problem: &PsaSettings,
+        build: &BuildInfo,
         extra: serde_json::Map<String, serde_json::Value>,
     ) -> NetworkFile {
-        let build = crate::provenance::build_info();
         let mut provenance = serde_json::Map::new();
-        provenance.insert("tool_version".into(), build.tool_version.into());
-        provenance.insert("git_commit".into(), build.git_commit.into());
-        provenance.insert("libode_version".into(), build.libode_version.into());
+        provenance.insert("tool_version".into(), build.tool_version.clone().into());
+        provenance.insert("git_commit".into(), build.git_commit.clone().into());
+        provenance.insert("libode_version".into(), build.libode_version.clone().into());
         provenance.extend(extra);
         NetworkFile {
             format: FORMAT.into(),
