@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::grid::{run_dir, GridSpec, RunKey};
 use super::replicate::{run_seed, test_and_mark, FinishedRun};
 use super::{Algorithm, GridConfig, RunConfig, RunStart};
-use crate::evaluator::PsaEvaluator;
+use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::lockstep::lockstep;
 use crate::evolution::{AskTell, Control, Esp, HillClimb};
 use crate::psa::Task;
@@ -45,12 +45,13 @@ struct Started {
 }
 
 /// Runs `todo` of `spec` in `dir` in lockstep on the current rayon pool,
-/// handing each run's outcome to `finished` as [`super::replicate::run_one`]
-/// would give it.
+/// their networks evaluated on `path`, handing each run's outcome to
+/// `finished` as [`super::replicate::run_one`] would give it.
 pub(super) fn replicate_lockstep(
     dir: &Path,
     spec: &GridSpec,
     todo: &[RunKey],
+    path: &EvalPath,
     finished: &(dyn Fn(Result<FinishedRun>) + Sync),
 ) {
     let mut evaluators: Vec<((GridConfig, Task), PsaEvaluator)> = Vec::new();
@@ -58,7 +59,7 @@ pub(super) fn replicate_lockstep(
     let mut runs: Vec<Box<dyn AskTell + Send>> = Vec::new();
     for key in todo {
         let folder = run_dir(dir, key);
-        match begin(spec, key, &folder, &mut evaluators) {
+        match begin(spec, key, &folder, path, &mut evaluators) {
             Ok((run, search)) => {
                 started.push(run);
                 runs.push(search);
@@ -104,6 +105,7 @@ fn begin(
     spec: &GridSpec,
     key: &RunKey,
     folder: &Path,
+    path: &EvalPath,
     evaluators: &mut Vec<((GridConfig, Task), PsaEvaluator)>,
 ) -> Result<(Started, Box<dyn AskTell + Send>)> {
     let config = spec.run_config(key.config)?;
@@ -113,7 +115,7 @@ fn begin(
     let evaluator = match evaluators.iter().position(|(c, _)| *c == cell) {
         Some(index) => index,
         None => {
-            evaluators.push((cell, PsaEvaluator::new(config.problem.clone(), key.task)?));
+            evaluators.push((cell, PsaEvaluator::new(config.problem.clone(), key.task, path)?));
             evaluators.len() - 1
         }
     };

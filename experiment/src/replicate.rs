@@ -20,6 +20,7 @@ use super::ode_check::check_on_ode;
 use super::robustness::test_robustness;
 use super::shard::Shard;
 use super::{run_evolution, EvolveOutcome, RunFiles};
+use crate::evaluator::EvalPath;
 use crate::psa::NetworkFile;
 
 /// Stream key of the run seeds.
@@ -56,8 +57,9 @@ pub trait GridProgress: Sync {
     fn finished(&self, run: &FinishedRun);
 }
 
-/// How [`replicate`] runs: threads, shard, claims.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// How [`replicate`] runs: threads, shard, claims, executor and evaluation
+/// path.
+#[derive(Debug, Clone)]
 pub struct ReplicateOptions {
     /// Worker threads (0 = one per core). Results do not depend on it.
     pub threads: usize,
@@ -69,6 +71,8 @@ pub struct ReplicateOptions {
     /// How the runs are advanced: run by run, or all in lockstep. Results
     /// do not depend on it.
     pub executor: Executor,
+    /// Where the runs' networks are evaluated. Results do not depend on it.
+    pub eval_path: EvalPath,
 }
 
 impl Default for ReplicateOptions {
@@ -78,6 +82,7 @@ impl Default for ReplicateOptions {
             shard: Shard::ALL,
             claim_timeout: DEFAULT_CLAIM_TIMEOUT,
             executor: Executor::RunByRun,
+            eval_path: EvalPath::Fastest,
         }
     }
 }
@@ -179,12 +184,13 @@ pub fn describe(spec: &GridSpec) -> String {
 /// Runs one run of the grid and its robustness tests, and with
 /// `spec.ode_check` flies its champion again on `ode` (recorded in
 /// `run.json`; a difference stops the run with an error naming it);
-/// `robustness.json`, written last, marks it finished.
-pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<FinishedRun> {
+/// `robustness.json`, written last, marks it finished. Its networks are
+/// evaluated on `path`.
+pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey, path: &EvalPath) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
     let config = spec.run_config(key.config)?;
     let seed = run_seed(key);
-    let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, |_| {})
+    let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, path, |_| {})
         .with_context(|| format!("run {}", folder.display()))?;
     test_and_mark(dir, spec, key, outcome)
 }
@@ -241,15 +247,15 @@ enum Outcome {
 
 /// Claims the run `key` and, unless another process has finished it
 /// meanwhile, runs it; the claim goes once its files are complete.
-fn claim_and_run(dir: &Path, spec: &GridSpec, key: &RunKey, timeout: Duration) -> Result<Outcome> {
-    let claim = match claim(&run_dir(dir, key), timeout)? {
+fn claim_and_run(dir: &Path, spec: &GridSpec, key: &RunKey, options: &ReplicateOptions) -> Result<Outcome> {
+    let claim = match claim(&run_dir(dir, key), options.claim_timeout)? {
         Attempt::Held(record) => return Ok(Outcome::Held(record)),
         Attempt::Claimed(claim) => claim,
     };
     if run_status(dir, spec, key)? == RunStatus::Finished {
         return Ok(Outcome::AlreadyFinished);
     }
-    let run = run_one(dir, spec, key)?;
+    let run = run_one(dir, spec, key, &options.eval_path)?;
     drop(claim);
     Ok(Outcome::Ran(run))
 }
@@ -284,7 +290,7 @@ pub fn replicate(
         Executor::RunByRun => {
             todo.par_iter()
                 .with_max_len(1)
-                .for_each(|key| match claim_and_run(dir, spec, key, options.claim_timeout) {
+                .for_each(|key| match claim_and_run(dir, spec, key, options) {
                     Ok(Outcome::Ran(run)) => finished(Ok(run)),
                     Ok(Outcome::AlreadyFinished) => {
                         finished_elsewhere.fetch_add(1, Ordering::Relaxed);
@@ -317,7 +323,7 @@ pub fn replicate(
                     Err(e) => finished(Err(e)),
                 }
             }
-            replicate_lockstep(dir, spec, &mine, &finished);
+            replicate_lockstep(dir, spec, &mine, &options.eval_path, &finished);
             drop(claims);
         }
     });

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use super::{Algorithm, RunConfig};
-use crate::evaluator::PsaEvaluator;
+use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::{Esp, GenerationRecord, HillClimb, RunResult};
 use crate::io::write_atomic;
 use crate::psa::{NetworkFile, Task};
@@ -144,17 +144,19 @@ impl LiveRecords {
 /// Runs `config` on `task` with `seed` on the current rayon pool and writes
 /// `config.toml`, `records.csv`, `champion.json` and `run.json` (each
 /// atomically) into `dir`; `records.csv` also grows a line per generation
-/// while the run goes. `on_generation` sees every record as it comes.
+/// while the run goes; its networks are evaluated on `path`. `on_generation`
+/// sees every record as it comes.
 pub fn run_evolution(
     config: &RunConfig,
     label: &str,
     task: Task,
     seed: u64,
     dir: &Path,
+    path: &EvalPath,
     mut on_generation: impl FnMut(&GenerationRecord),
 ) -> Result<EvolveOutcome> {
     let mut started = RunStart::new(config, dir)?;
-    let evaluator = PsaEvaluator::new(config.problem.clone(), task)?;
+    let evaluator = PsaEvaluator::new(config.problem.clone(), task, path)?;
     let on_generation = |record: &GenerationRecord| {
         started.record(record);
         on_generation(record);

@@ -346,7 +346,7 @@ pub fn sweep(
         let grid = spec.variant_grid(variant)?;
         let variant_options = ReplicateOptions {
             shard: options.shard.after(before),
-            ..*options
+            ..options.clone()
         };
         before += grid.runs().len();
         let ReplicateSummary {

@@ -1,7 +1,7 @@
 //! The PSA control problem as an [`Evaluator`] for the search algorithms.
 
 use std::ops::Range;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use anyhow::Result;
 
@@ -15,32 +15,71 @@ use crate::psa::ode_lockstep::ODE_LOCKSTEP;
 use crate::psa::{BatchRunner, OdeLockstepRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use crate::rng::{Stream, StreamFamily};
 
-/// The environment variable that picks the evaluation path: `scalar` (one
-/// network at a time, on `ode` one world per network), a SIMD level
-/// (`portable`, `avx2`, `avx512`) for `native`'s batched path, or
-/// `kernel-host` for `native` flown by the cuda path's kernel built for
-/// the host (the GPU path's plumbing without a GPU, slowly); unset, the
-/// best level of the CPU, and on `ode` the lockstep path. It changes speed
-/// only: every path gives the same results, bit for bit.
-pub const SIMD_VARIABLE: &str = "PSA_ESP_SIMD";
-
-/// The [`SIMD_VARIABLE`] value for the cuda kernel built for the host.
-pub const KERNEL_ON_HOST: &str = "kernel-host";
-
 /// Networks per batch on the cuda kernel: more than any run asks at once,
 /// so that a run's generation goes to the device in one launch.
 pub const CUDA_BATCH: usize = 1 << 20;
 
-/// What every `native` evaluator of the process flies its trials on, once
-/// [`fly_trials_on`] has set it.
-static FLIER: OnceLock<Arc<dyn TrialFlier>> = OnceLock::new();
+/// How a [`PsaEvaluator`] flies its trials, named by its caller. Every path
+/// gives the same results, bit for bit: the choice changes speed only.
+#[derive(Debug, Clone, Default)]
+pub enum EvalPath {
+    /// The fastest path of the backend: on `native` the batched path at the
+    /// processor's best SIMD level, on `ode` the lockstep path where the
+    /// settings allow it, else one network at a time.
+    #[default]
+    Fastest,
+    /// One network at a time (on `ode` one world per network): the reference.
+    Scalar,
+    /// `native`'s batched path at this SIMD level.
+    Simd(SimdLevel),
+    /// `ode`'s lockstep path: a batch of networks as bodies of one world.
+    OdeLockstep,
+    /// `native`'s trials flown by the cuda kernel built for the host: the
+    /// GPU path's plumbing without a GPU, slowly.
+    KernelOnHost,
+    /// `native`'s trials flown by a kernel flier (`--backend cuda`: a GPU).
+    Kernel(Arc<dyn TrialFlier>),
+}
 
-/// Makes every [`PsaEvaluator`] made from now on with the `native`
-/// backend fly its trials on `flier` (`--backend cuda`: the GPU). Like
-/// [`SIMD_VARIABLE`], it changes speed only: the kernel computes the
-/// batched path's results bit for bit. A second call keeps the first.
-pub fn fly_trials_on(flier: Arc<dyn TrialFlier>) {
-    let _ = FLIER.set(flier);
+impl EvalPath {
+    /// The names [`EvalPath::from_str`] reads: every path but
+    /// [`EvalPath::Kernel`], which needs a device.
+    pub const NAMES: [&'static str; 7] = [
+        "fastest",
+        "scalar",
+        "portable",
+        "avx2",
+        "avx512",
+        "ode-lockstep",
+        "kernel-host",
+    ];
+
+    /// The backend the path flies on, if it needs one.
+    fn backend(&self) -> Option<BackendKind> {
+        match self {
+            EvalPath::Fastest | EvalPath::Scalar => None,
+            EvalPath::OdeLockstep => Some(BackendKind::Ode),
+            EvalPath::Simd(_) | EvalPath::KernelOnHost | EvalPath::Kernel(_) => Some(BackendKind::Native),
+        }
+    }
+}
+
+impl std::str::FromStr for EvalPath {
+    type Err = String;
+    fn from_str(name: &str) -> Result<EvalPath, String> {
+        match name {
+            "fastest" => Ok(EvalPath::Fastest),
+            "scalar" => Ok(EvalPath::Scalar),
+            "ode-lockstep" => Ok(EvalPath::OdeLockstep),
+            "kernel-host" => Ok(EvalPath::KernelOnHost),
+            _ => name.parse().map(EvalPath::Simd).map_err(|_| {
+                format!(
+                    "unknown evaluation path {name:?} (expected one of {})",
+                    EvalPath::NAMES.join(", ")
+                )
+            }),
+        }
+    }
 }
 
 /// Scores a network by its fitness on a task (in % of the theoretical
@@ -79,67 +118,48 @@ impl PsaEvaluator {
 }
 
 impl PsaEvaluator {
-    /// An evaluator of `task`; fails on invalid settings.
-    pub fn new(settings: PsaSettings, task: Task) -> Result<PsaEvaluator> {
+    /// An evaluator of `task` on `path`; fails on invalid settings, and on
+    /// a path the backend does not have (a SIMD level or a kernel on
+    /// anything but `native`, the lockstep path on anything but `ode` with
+    /// step settings it supports).
+    pub fn new(settings: PsaSettings, task: Task, path: &EvalPath) -> Result<PsaEvaluator> {
         // Building one runner checks every setting (and random init vs task) up front.
         TrialRunner::new(&settings, task)?;
-        let batch = match settings.backend {
-            BackendKind::Native => Some(BatchRunner::new(&settings, task)?),
+        if let Some(backend) = path.backend().filter(|&b| b != settings.backend) {
+            anyhow::bail!(
+                "the evaluation path {path:?} runs on the {backend} backend, not on {}",
+                settings.backend
+            );
+        }
+        let native = settings.backend == BackendKind::Native;
+        let batch = match path {
+            EvalPath::Scalar | EvalPath::OdeLockstep => None,
+            EvalPath::Simd(level) => Some(BatchRunner::new(&settings, task)?.with_level(*level)),
+            EvalPath::Fastest | EvalPath::KernelOnHost | EvalPath::Kernel(_) if native => {
+                Some(BatchRunner::new(&settings, task)?)
+            }
+            EvalPath::Fastest | EvalPath::KernelOnHost | EvalPath::Kernel(_) => None,
+        };
+        let ode_lockstep = match path {
+            EvalPath::Fastest => OdeLockstepRunner::supports(&settings),
+            EvalPath::OdeLockstep => {
+                OdeLockstepRunner::new(&settings, task)?;
+                true
+            }
+            _ => false,
+        };
+        let kernel: Option<Arc<dyn TrialFlier>> = match path {
+            EvalPath::KernelOnHost => Some(Arc::new(HostTrials)),
+            EvalPath::Kernel(flier) => Some(flier.clone()),
             _ => None,
         };
-        let ode_lockstep = OdeLockstepRunner::supports(&settings);
-        let kernel = FLIER.get().filter(|_| settings.backend == BackendKind::Native).cloned();
-        let evaluator = PsaEvaluator {
+        Ok(PsaEvaluator {
             settings,
             task,
             batch,
             ode_lockstep,
             kernel,
-        };
-        Ok(match std::env::var(SIMD_VARIABLE) {
-            Err(_) => evaluator,
-            Ok(choice) if choice == "scalar" => evaluator.with_batching(None).with_ode_lockstep(false),
-            Ok(choice) if choice == KERNEL_ON_HOST => evaluator.with_kernel_on_host(),
-            Ok(choice) => {
-                evaluator.with_batching(Some(choice.parse().map_err(|e| {
-                    anyhow::anyhow!("{SIMD_VARIABLE}={choice:?}: {e} (or scalar for the scalar path)")
-                })?))
-            }
         })
-    }
-
-    /// The same evaluator on `native` with the batched path on `level`, or
-    /// with `None` the scalar reference: for benchmarks and cross-checks
-    /// (every choice gives the same results). Other backends stay scalar.
-    pub fn with_batching(mut self, level: Option<SimdLevel>) -> PsaEvaluator {
-        self.batch = match (self.batch.take(), level) {
-            (Some(batch), Some(level)) => Some(batch.with_level(level)),
-            (Some(_), None) => None,
-            (None, _) => BatchRunner::new(&self.settings, self.task)
-                .ok()
-                .zip(level)
-                .map(|(b, l)| b.with_level(l)),
-        };
-        self
-    }
-
-    /// The same evaluator on `native` flying its trials through the cuda
-    /// kernel built for the host (where no GPU is set already), for
-    /// checks (the same results, slowly). Other backends are unchanged.
-    pub fn with_kernel_on_host(mut self) -> PsaEvaluator {
-        if self.settings.backend == BackendKind::Native && self.kernel.is_none() {
-            self.kernel = Some(Arc::new(HostTrials));
-        }
-        self
-    }
-
-    /// The same evaluator with `ode`'s lockstep path on (where the settings
-    /// allow it: see [`OdeLockstepRunner::supports`]) or off (one world per
-    /// network, the reference): for benchmarks and cross-checks (both give
-    /// the same results). Other backends are unchanged.
-    pub fn with_ode_lockstep(mut self, on: bool) -> PsaEvaluator {
-        self.ode_lockstep = on && OdeLockstepRunner::supports(&self.settings);
-        self
     }
 }
 

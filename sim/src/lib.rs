@@ -36,4 +36,4 @@ pub mod psa;
 pub use esp_neuroevolution as evolution;
 pub use esp_neuroevolution::{network, rng};
 
-pub use evaluator::{PsaEvaluator, PsaWorker};
+pub use evaluator::{EvalPath, PsaEvaluator, PsaWorker};

@@ -16,7 +16,7 @@ use serde::Serialize;
 
 use super::bench_kernel::{kernel_rows, KERNEL_NETWORKS};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
-use crate::evaluator::PsaEvaluator;
+use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::evaluate_all;
 use crate::evolution::operators::random_genes;
 use crate::network::Network;
@@ -46,10 +46,14 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(2..=100_000))]
     pub generations: u64,
     /// Networks per launch of the cuda kernel's rows, beside `native`
-    /// (measured only where a GPU is, or with PSA_ESP_SIMD=kernel-host).
+    /// (measured only where a GPU is, or with --kernel-host).
     #[arg(long, value_delimiter = ',', default_values_t = KERNEL_NETWORKS,
           value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub kernel_networks: Vec<u64>,
+    /// Time the cuda kernel's rows on the kernel built for the host instead
+    /// of a GPU (the rows' plumbing without one, slowly).
+    #[arg(long)]
+    pub kernel_host: bool,
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
@@ -118,9 +122,12 @@ impl EvaluationPath {
             backend: self.backend,
             ..PsaSettings::default()
         };
-        Ok(PsaEvaluator::new(settings, Task::StopRotation)?
-            .with_batching(self.simd)
-            .with_ode_lockstep(self.ode_lockstep))
+        let path = match (self.simd, self.ode_lockstep) {
+            (Some(level), _) => EvalPath::Simd(level),
+            (None, true) => EvalPath::OdeLockstep,
+            (None, false) => EvalPath::Scalar,
+        };
+        PsaEvaluator::new(settings, Task::StopRotation, &path)
     }
 }
 
@@ -350,7 +357,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
     let replicate = replicate_workload(generations)?.scaling(args.rounds)?;
     // Long enough that the set-up before the first generation does not count.
     let overhead = algorithm_overhead(5 * generations, args.rounds)?;
-    let kernel = kernel_rows(&args.kernel_networks, args.rounds)?;
+    let kernel = kernel_rows(&args.kernel_networks, args.rounds, args.kernel_host)?;
     let machine = machine();
     if args.json {
         let out = serde_json::json!({

@@ -32,9 +32,8 @@ pub struct SweepArgs {
 pub fn run(args: SweepArgs) -> Result<i32> {
     let vary = args.vary.iter().map(|v| parse_vary(v)).collect::<Result<Vec<_>>>()?;
     let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
-    args.grid.prepare_backend()?;
     let progress = Progress::new(args.grid.quiet);
-    let summary = sweep(&args.out, &spec, &args.grid.options(), &progress)?;
+    let summary = sweep(&args.out, &spec, &args.grid.options()?, &progress)?;
     progress.bar.finish_and_clear();
     report_held(summary.held.iter().map(|(variant, h)| (format!("{variant}: "), h)));
     say!(
