@@ -1,5 +1,5 @@
 //! The PSA's body: a round hull and four thrusters of one density, and the
-//! thruster table of the spec (`psa-model.md` §1).
+//! thruster table of the spec (`docs/specification.md` §1).
 //!
 //! | thruster | mount (body) | force (body) | torque |
 //! |---|---|---|---|

@@ -1,4 +1,4 @@
-//! The two fitness functions (`psa-model.md` §4), scored step by step.
+//! The two fitness functions (`docs/specification.md` §4), scored step by step.
 
 use serde::{Deserialize, Serialize};
 

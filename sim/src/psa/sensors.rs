@@ -1,5 +1,5 @@
 //! What the controller sees and how its outputs reach the thrusters
-//! (`psa-model.md` §2): inputs relative to the target in the world frame,
+//! (`docs/specification.md` §2): inputs relative to the target in the world frame,
 //! scaled, with Gaussian noise on inputs and outputs.
 
 use rand::Rng;

@@ -1,4 +1,4 @@
-//! The paper's three tasks (`psa-model.md` §3): start states, targets and
+//! The paper's three tasks (`docs/specification.md` §3): start states, targets and
 //! the random-initialisation variants.
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
