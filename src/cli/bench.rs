@@ -15,18 +15,15 @@ use multiversion::multiversion;
 use serde::Serialize;
 
 use super::bench_kernel::{kernel_rows, KERNEL_NETWORKS};
+use super::bench_networks::{random_networks, HIDDEN};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
 use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::evaluate_all;
-use crate::evolution::operators::random_genes;
 use crate::network::Network;
 use crate::numeric::{sigmoid, Lanes, SimdLevel};
 use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
 use crate::psa::batch::LANES;
-use crate::psa::{BodySettings, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
-
-/// Hidden neurons of the benchmark's networks (the paper's 7-5-4 network).
-const HIDDEN: usize = 5;
+use crate::psa::{BodySettings, PsaSettings, Task, THRUSTER_COUNT};
 
 /// Arguments of `bench`.
 #[derive(Debug, clap::Args)]
@@ -139,20 +136,6 @@ struct EvaluationTiming {
     evaluations_per_second_2_threads: f64,
     speedup_2_threads: f64,
     ns_per_network_step_1_thread: f64,
-}
-
-/// Random 7-5-4 networks, weights uniform in (-6, 6) as ESP starts them.
-pub fn random_networks(count: u64) -> Result<Vec<Network>> {
-    let mut rng = crate::rng::stream(1, &[]);
-    (0..count)
-        .map(|_| {
-            Ok(Network::from_genes(
-                INPUT_COUNT,
-                THRUSTER_COUNT,
-                random_genes(&mut rng, HIDDEN * (INPUT_COUNT + THRUSTER_COUNT), 6.0),
-            )?)
-        })
-        .collect()
 }
 
 /// Evaluations per second of `networks` on task 1 with `threads` threads

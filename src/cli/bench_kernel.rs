@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::Result;
 use serde::Serialize;
 
-use super::bench::random_networks;
+use super::bench_networks::random_networks;
 use super::bench_runs::median;
 use crate::network::Network;
 use crate::physics::{BackendKind, PlanarBody};

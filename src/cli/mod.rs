@@ -11,6 +11,7 @@ macro_rules! say {
 mod backend;
 pub mod bench;
 pub mod bench_kernel;
+pub mod bench_networks;
 pub mod bench_ode;
 pub mod bench_runs;
 mod choice;

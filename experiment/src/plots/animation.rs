@@ -4,7 +4,7 @@
 
 use std::fmt::Write;
 
-use super::trial::{equal_aspect, TrialPicture, THRUSTER_COLORS, THRUSTER_NAMES};
+use super::picture::{equal_aspect, TrialPicture, THRUSTER_COLORS, THRUSTER_NAMES};
 
 /// At most this many key frames are written; longer trials are sub-sampled.
 pub const MAX_FRAMES: usize = 1000;
@@ -559,7 +559,7 @@ fn write_legend(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plots::trial::tests::{picture, spiral};
+    use crate::plots::picture::tests::{picture, spiral};
 
     #[test]
     fn frames_cover_the_whole_trial() {

@@ -15,7 +15,9 @@ mod animation;
 pub mod curves;
 mod font;
 mod output;
+pub mod picture;
 pub mod trial;
 
 pub use font::{ensure_font, FONT_ENV_VAR, FONT_FAMILY, FONT_PACKAGE};
-pub use trial::{write_trial_pictures, TrialPicture};
+pub use picture::TrialPicture;
+pub use trial::write_trial_pictures;
