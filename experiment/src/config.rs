@@ -70,6 +70,10 @@ impl RunConfig {
     }
 }
 
+/// The baseline configuration (Table 1), which the report compares every
+/// other configuration with.
+pub const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
+
 /// One configuration of the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]

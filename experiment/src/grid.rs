@@ -122,7 +122,7 @@ impl GridSpec {
             version: GRID_VERSION,
             preset,
             configs: GridConfig::ALL.into_iter().filter(|c| c.in_paper()).collect(),
-            tasks: Task::ALL.to_vec(),
+            tasks: Task::ALL.into_iter().filter(|t| t.in_paper()).collect(),
             seeds,
             generations,
             backend,

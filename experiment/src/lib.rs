@@ -8,13 +8,16 @@
 //! may not depend on it. `.ci/run` checks its `cargo tree`.
 
 pub mod claim;
+pub mod columns;
 mod config;
 pub mod grid;
+pub mod grid_run;
 pub mod lockstep;
 pub mod ode_check;
 pub mod plots;
 pub mod replicate;
 pub mod report;
+pub mod results;
 pub mod robustness;
 mod run;
 pub mod runs_table;
@@ -22,9 +25,12 @@ pub mod shard;
 pub mod stats;
 pub mod sweep;
 
-pub use config::{paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, PAPER_NOISE_SD, PAPER_NOISY_TRIALS};
+pub use config::{
+    paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, BASELINE, PAPER_NOISE_SD, PAPER_NOISY_TRIALS,
+};
 pub use report::{write_report, ReportFormat, ReportOutcome};
-pub use run::{records_csv, run_evolution, EvolveOutcome, RunFiles, RunStart};
+pub use results::EvolveOutcome;
+pub use run::{records_csv, run_evolution, RunFiles, RunStart};
 
 // The lower layers under the paths this crate's modules name them by
 // (`crate::psa`, `crate::evolution`, ...).

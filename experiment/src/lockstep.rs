@@ -12,7 +12,7 @@ use anyhow::{Context, Result};
 use rayon::prelude::*;
 
 use super::grid::{run_dir, GridSpec, RunKey};
-use super::replicate::{run_seed, test_and_mark, FinishedRun};
+use super::grid_run::{run_seed, test_and_mark, FinishedRun};
 use super::{Algorithm, GridConfig, RunConfig, RunStart};
 use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::lockstep::lockstep;
@@ -46,7 +46,7 @@ struct Started {
 
 /// Runs `todo` of `spec` in `dir` in lockstep on the current rayon pool,
 /// their networks evaluated on `path`, handing each run's outcome to
-/// `finished` as [`super::replicate::run_one`] would give it.
+/// `finished` as [`crate::grid_run::run_one`] would give it.
 pub(super) fn replicate_lockstep(
     dir: &Path,
     spec: &GridSpec,

@@ -10,43 +10,14 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
-use rand::RngExt;
 use rayon::prelude::*;
 
-use super::claim::{claim, Attempt, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
-use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
+use super::claim::{claim, Attempt, Claim, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
+use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
+use super::grid_run::{run_one, FinishedRun};
 use super::lockstep::{replicate_lockstep, Executor};
-use super::ode_check::check_on_ode;
-use super::robustness::test_robustness;
 use super::shard::Shard;
-use super::{run_evolution, EvolveOutcome, RunFiles};
 use crate::evaluator::EvalPath;
-use crate::psa::NetworkFile;
-
-/// Stream key of the run seeds.
-const RUN_SEED: u64 = 201;
-
-/// The seed a run actually uses: derived from the grid seed, the
-/// configuration and the task, so that runs of different configurations or
-/// tasks are independent samples (Welch's test assumes it). `psa-esp evolve
-/// --seed` with this value repeats the run.
-pub fn run_seed(key: &RunKey) -> u64 {
-    let config_key = key
-        .config
-        .name()
-        .bytes()
-        .fold(0u64, |h, b| h.wrapping_mul(131).wrapping_add(b as u64));
-    crate::rng::stream(key.seed, &[RUN_SEED, config_key, key.task.number() as u64]).random::<u64>()
-}
-
-/// What happened to one run.
-#[derive(Debug, Clone)]
-pub struct FinishedRun {
-    /// The run.
-    pub key: RunKey,
-    /// Its outcome.
-    pub outcome: EvolveOutcome,
-}
 
 /// Something to tell the user while the grid runs.
 pub trait GridProgress: Sync {
@@ -181,83 +152,27 @@ pub fn describe(spec: &GridSpec) -> String {
     )
 }
 
-/// Runs one run of the grid and its robustness tests, and with
-/// `spec.ode_check` flies its champion again on `ode` (recorded in
-/// `run.json`; a difference stops the run with an error naming it);
-/// `robustness.json`, written last, marks it finished. Its networks are
-/// evaluated on `path`.
-pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey, path: &EvalPath) -> Result<FinishedRun> {
-    let folder = run_dir(dir, key);
-    let config = spec.run_config(key.config)?;
-    let seed = run_seed(key);
-    let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, path, |_| {})
-        .with_context(|| format!("run {}", folder.display()))?;
-    test_and_mark(dir, spec, key, outcome)
-}
-
-/// A run's robustness tests, once its evolution is written, and its ODE
-/// check when `spec.ode_check` (recorded in `run.json`; a difference is an
-/// error naming the run); then writes `robustness.json`, which marks it
-/// finished.
-pub(super) fn test_and_mark(
-    dir: &Path,
-    spec: &GridSpec,
-    key: &RunKey,
-    mut outcome: EvolveOutcome,
-) -> Result<FinishedRun> {
-    let folder = run_dir(dir, key);
-    let config = spec.run_config(key.config)?;
-    let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
-    let robustness = test_robustness(
-        &champion,
-        key.task,
-        &config.problem,
-        spec.robustness_trials,
-        outcome.seed,
-    )?;
-    if spec.ode_check {
-        let check = check_on_ode(
-            &champion,
-            key.task,
-            &config.problem,
-            spec.robustness_trials,
-            outcome.seed,
-            &robustness,
-        )
-        .with_context(|| format!("run {}: the ODE check", folder.display()))?;
-        outcome.ode_check = Some(check.clone());
-        outcome.save(&RunFiles::in_dir(&folder).summary)?;
-        check.verify(&folder.display().to_string())?;
-    }
-    let mut json = serde_json::to_string_pretty(&robustness)?;
-    json.push('\n');
-    crate::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())?;
-    Ok(FinishedRun { key: *key, outcome })
-}
-
-/// What became of one run this process went for.
-enum Outcome {
-    /// This process ran it.
-    Ran(FinishedRun),
+/// What claiming a run found.
+enum Claimed {
+    /// The run is this process's (until the claim is dropped), and unfinished.
+    Mine(Claim),
     /// Another process finished it first.
     AlreadyFinished,
     /// Another process is running it.
     Held(ClaimRecord),
 }
 
-/// Claims the run `key` and, unless another process has finished it
-/// meanwhile, runs it; the claim goes once its files are complete.
-fn claim_and_run(dir: &Path, spec: &GridSpec, key: &RunKey, options: &ReplicateOptions) -> Result<Outcome> {
-    let claim = match claim(&run_dir(dir, key), options.claim_timeout)? {
-        Attempt::Held(record) => return Ok(Outcome::Held(record)),
+/// Claims the run `key` unless another live process holds it; a run
+/// another process finished meanwhile is left alone.
+fn claim_unfinished(dir: &Path, spec: &GridSpec, key: &RunKey, timeout: Duration) -> Result<Claimed> {
+    let claim = match claim(&run_dir(dir, key), timeout)? {
+        Attempt::Held(record) => return Ok(Claimed::Held(record)),
         Attempt::Claimed(claim) => claim,
     };
     if run_status(dir, spec, key)? == RunStatus::Finished {
-        return Ok(Outcome::AlreadyFinished);
+        return Ok(Claimed::AlreadyFinished);
     }
-    let run = run_one(dir, spec, key, &options.eval_path)?;
-    drop(claim);
-    Ok(Outcome::Ran(run))
+    Ok(Claimed::Mine(claim))
 }
 
 /// Runs every unfinished run of `options.shard` of `spec` in `dir`, on
@@ -286,41 +201,41 @@ pub fn replicate(
         }
         Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
     };
-    pool.install(|| match options.executor {
-        Executor::RunByRun => {
-            todo.par_iter()
-                .with_max_len(1)
-                .for_each(|key| match claim_and_run(dir, spec, key, options) {
-                    Ok(Outcome::Ran(run)) => finished(Ok(run)),
-                    Ok(Outcome::AlreadyFinished) => {
-                        finished_elsewhere.fetch_add(1, Ordering::Relaxed);
-                    }
-                    Ok(Outcome::Held(claim)) => held.lock().expect(lock).push(HeldRun { key: *key, claim }),
-                    Err(e) => finished(Err(e)),
-                })
+    // The claim on `key` if the run is this process's; the other outcomes
+    // are counted here.
+    let take = |key: &RunKey| match claim_unfinished(dir, spec, key, options.claim_timeout) {
+        Ok(Claimed::Mine(claim)) => Some(claim),
+        Ok(Claimed::AlreadyFinished) => {
+            finished_elsewhere.fetch_add(1, Ordering::Relaxed);
+            None
         }
+        Ok(Claimed::Held(claim)) => {
+            held.lock().expect(lock).push(HeldRun { key: *key, claim });
+            None
+        }
+        Err(e) => {
+            finished(Err(e));
+            None
+        }
+    };
+    pool.install(|| match options.executor {
+        Executor::RunByRun => todo.par_iter().with_max_len(1).for_each(|key| {
+            if let Some(claim) = take(key) {
+                // The claim goes once the run's files are complete.
+                let run = run_one(dir, spec, key, &options.eval_path);
+                drop(claim);
+                finished(run);
+            }
+        }),
         Executor::Lockstep => {
             // Every run is claimed before the first round and released once
             // all are written.
             let mut claims = Vec::new();
             let mut mine = Vec::new();
             for key in &todo {
-                match claim(&run_dir(dir, key), options.claim_timeout) {
-                    Ok(Attempt::Held(record)) => held.lock().expect(lock).push(HeldRun {
-                        key: *key,
-                        claim: record,
-                    }),
-                    Ok(Attempt::Claimed(claim)) => match run_status(dir, spec, key) {
-                        Ok(RunStatus::Finished) => {
-                            finished_elsewhere.fetch_add(1, Ordering::Relaxed);
-                        }
-                        Ok(_) => {
-                            claims.push(claim);
-                            mine.push(*key);
-                        }
-                        Err(e) => finished(Err(e)),
-                    },
-                    Err(e) => finished(Err(e)),
+                if let Some(claim) = take(key) {
+                    claims.push(claim);
+                    mine.push(*key);
                 }
             }
             replicate_lockstep(dir, spec, &mine, &options.eval_path, &finished);

@@ -22,19 +22,20 @@ mod tests;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
-use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
-use super::robustness::Robustness;
+use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
 use super::runs_table::{runs_csv, RUNS_CSV};
 use super::GridConfig;
-use crate::physics::BackendKind;
-use crate::provenance::BuildInfo;
 use crate::psa::Task;
+use crate::results::{load_run, GenerationRow, RunData};
 
 pub use distance::{Distance, Term};
 pub use findings::{Finding, Rule, Verdict, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
-pub use paper::{paper_bursts, paper_cell, PaperCell, PAPER_BURSTS, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK};
+pub use paper::{
+    paper_bursts, paper_bursts_per_run, paper_cell, PaperCell, PAPER_BURSTS, PAPER_BURST_RUNS, PAPER_RUNS_ALL,
+    PAPER_RUNS_PER_TASK, PAPER_TASKS,
+};
 pub use sweep::{write_sweep_report, SweepReport};
 pub use tables::{BurstRow, FigureLink, MissingCell, Report, Row, Table};
 
@@ -93,75 +94,15 @@ impl Metric {
     }
 }
 
-/// The fields of `run.json` the report reads.
-#[derive(Debug, Deserialize)]
-struct RunSummary {
-    task: Task,
-    #[serde(deserialize_with = "crate::io::u64_string::deserialize")]
-    seed: u64,
-    backend: BackendKind,
-    champion_fitness: f64,
-    champion_generation: usize,
-    evaluations: u64,
-    bursts: usize,
-    champion_hidden: usize,
-    seconds: f64,
-    build: BuildInfo,
-}
-
-/// One generation of `records.csv` (the columns the report uses), fitness in %.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GenerationRow {
-    /// Generation (cycle), from 1.
-    pub generation: usize,
-    /// Worst network of the generation.
-    pub min: f64,
-    /// Mean network of the generation.
-    pub mean: f64,
-    /// Best network of the generation.
-    pub max: f64,
-    /// Best network so far (the champion).
-    pub champion: f64,
-}
-
-/// A finished run whose files all parse.
-#[derive(Debug, Clone)]
-pub struct RunData {
-    /// The run.
-    pub key: RunKey,
-    /// The seed the run used (`run.json`'s `seed`).
-    pub run_seed: u64,
-    /// Its physics backend.
-    pub backend: BackendKind,
-    /// Champion fitness (%).
-    pub champion: f64,
-    /// The generation (cycle) the champion was found in.
-    pub champion_generation: usize,
-    /// Network evaluations, lesion tests included.
-    pub evaluations: u64,
-    /// Burst mutations.
-    pub bursts: usize,
-    /// Hidden neurons of the champion.
-    pub champion_hidden: usize,
-    /// Wall-clock seconds.
-    pub seconds: f64,
-    /// The build that made it.
-    pub build: BuildInfo,
-    /// The robustness tests of its champion.
-    pub robustness: Robustness,
-    /// One row per generation.
-    pub records: Vec<GenerationRow>,
-}
-
 impl RunData {
     /// The run's value of `metric`, if it has one (random init: tasks 1 and 3).
     pub fn value(&self, metric: Metric) -> Option<f64> {
         match metric {
-            Metric::Champion => Some(self.champion),
+            Metric::Champion => Some(self.summary.champion_fitness),
             Metric::Clean => Some(self.robustness.clean),
             Metric::InputNoise => Some(self.robustness.input_noise.mean),
             Metric::RandomInit => self.robustness.random_init.map(|r| r.mean),
-            Metric::Bursts => Some(self.bursts as f64),
+            Metric::Bursts => Some(self.summary.bursts as f64),
         }
     }
 }
@@ -257,85 +198,6 @@ impl GridResults {
     pub fn values(&self, config: GridConfig, tasks: &[Task], metric: Metric) -> Vec<f64> {
         self.runs_of(config, tasks).filter_map(|r| r.value(metric)).collect()
     }
-}
-
-/// Reads the files of a finished run.
-fn load_run(folder: &Path, key: &RunKey) -> Result<RunData> {
-    let read = |name: &str| -> Result<(PathBuf, String)> {
-        let path = folder.join(name);
-        let text = crate::io::read_input(&path, "run file")?;
-        Ok((path, text))
-    };
-    let (path, text) = read("run.json")?;
-    let summary: RunSummary =
-        serde_json::from_str(&text).with_context(|| format!("{}: damaged file", path.display()))?;
-    if summary.task != key.task || !summary.champion_fitness.is_finite() {
-        bail!(
-            "{}: task {} and champion fitness {} do not fit the run of task {}",
-            path.display(),
-            summary.task,
-            summary.champion_fitness,
-            key.task
-        );
-    }
-    let (path, text) = read(FINISHED_MARKER)?;
-    let robustness: Robustness =
-        serde_json::from_str(&text).with_context(|| format!("{}: damaged file", path.display()))?;
-    let (path, text) = read("records.csv")?;
-    let records = parse_records(&text).with_context(|| format!("{}: damaged file", path.display()))?;
-    Ok(RunData {
-        key: *key,
-        run_seed: summary.seed,
-        backend: summary.backend,
-        champion: summary.champion_fitness,
-        champion_generation: summary.champion_generation,
-        evaluations: summary.evaluations,
-        bursts: summary.bursts,
-        champion_hidden: summary.champion_hidden,
-        seconds: summary.seconds,
-        build: summary.build,
-        robustness,
-        records,
-    })
-}
-
-/// Parses `records.csv` by its header's column names.
-pub fn parse_records(text: &str) -> Result<Vec<GenerationRow>> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().context("empty file")?.split(',').collect();
-    let column = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .with_context(|| format!("no column {name:?} in the header"))
-    };
-    let [g, min, mean, max, champion] = ["generation", "min", "mean", "max", "champion"].map(column);
-    let (g, min, mean, max, champion) = (g?, min?, mean?, max?, champion?);
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let fields: Vec<&str> = line.split(',').collect();
-        let number = |c: usize| -> Result<f64> {
-            let field = fields.get(c).copied().unwrap_or("");
-            let v: f64 = field
-                .parse()
-                .with_context(|| format!("line {}: {:?} is not a number", i + 2, field))?;
-            if !v.is_finite() {
-                bail!("line {}: {v} is not finite", i + 2);
-            }
-            Ok(v)
-        };
-        rows.push(GenerationRow {
-            generation: number(g)? as usize,
-            min: number(min)?,
-            mean: number(mean)?,
-            max: number(max)?,
-            champion: number(champion)?,
-        });
-    }
-    if rows.is_empty() {
-        bail!("no generations");
-    }
-    Ok(rows)
 }
 
 /// What [`write_report`] did.

@@ -4,14 +4,14 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result};
-use serde::Serialize;
-
 use super::{Algorithm, RunConfig};
+use crate::columns::{header, row, Column};
 use crate::evaluator::{EvalPath, PsaEvaluator};
-use crate::evolution::{Esp, GenerationRecord, HillClimb, RunResult};
+use crate::evolution::{Esp, GenerationRecord, HillClimb, LesionOutcome, RunResult};
 use crate::io::write_atomic;
 use crate::psa::{NetworkFile, Task};
+use crate::results::EvolveOutcome;
+use anyhow::{Context, Result};
 
 /// The files of a run directory.
 #[derive(Debug, Clone)]
@@ -38,73 +38,78 @@ impl RunFiles {
     }
 }
 
-/// What `run.json` holds.
-#[derive(Debug, Clone, Serialize)]
-pub struct EvolveOutcome {
-    /// The task.
-    pub task: Task,
-    /// The seed (written as a string: see [`crate::io::u64_string`]).
-    #[serde(serialize_with = "crate::io::u64_string::serialize")]
-    pub seed: u64,
-    /// A label for the configuration (the preset's name).
-    pub label: String,
-    /// The physics backend.
-    pub backend: crate::physics::BackendKind,
-    /// The champion's fitness (% of the theoretical maximum).
-    pub champion_fitness: f64,
-    /// The generation (cycle) it was found in.
-    pub champion_generation: usize,
-    /// Generations (cycles) run.
-    pub generations: usize,
-    /// Network evaluations used, lesion tests included.
-    pub evaluations: u64,
-    /// Burst mutations.
-    pub bursts: usize,
-    /// Hidden neurons of the champion.
-    pub champion_hidden: usize,
-    /// Tool version, git commit, libode version.
-    pub build: crate::provenance::BuildInfo,
-    /// Start time (RFC 3339).
-    pub started: String,
-    /// End time (RFC 3339).
-    pub finished: String,
-    /// Wall-clock seconds.
-    pub seconds: f64,
-    /// The ODE check of a grid run on `native` (see
-    /// [`super::ode_check`]), added once the check ran.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub ode_check: Option<super::ode_check::OdeCheck>,
-}
+/// The columns of `records.csv`, one row per generation (hill-climber: per
+/// cycle); fitness in % of the task's theoretical maximum.
+pub const RECORD_COLUMNS: [Column<GenerationRecord>; 11] = [
+    Column {
+        name: "generation",
+        doc: "the generation (hill-climber: the cycle), from 1",
+        value: |r| r.generation.to_string(),
+    },
+    Column {
+        name: "min",
+        doc: "the lowest network fitness of the generation",
+        value: |r| r.min.to_string(),
+    },
+    Column {
+        name: "mean",
+        doc: "the mean network fitness of the generation",
+        value: |r| r.mean.to_string(),
+    },
+    Column {
+        name: "max",
+        doc: "the highest network fitness of the generation",
+        value: |r| r.max.to_string(),
+    },
+    Column {
+        name: "best",
+        doc: "the search's best network fitness so far (empty right after `erase_best` forgot it)",
+        value: |r| r.best.map_or(String::new(), |b| b.to_string()),
+    },
+    Column {
+        name: "champion",
+        doc: "the champion's fitness: the best network ever evaluated",
+        value: |r| r.champion.to_string(),
+    },
+    Column {
+        name: "evaluations",
+        doc: "network evaluations so far, lesion tests included",
+        value: |r| r.evaluations.to_string(),
+    },
+    Column {
+        name: "subpops",
+        doc: "sub-populations after the generation",
+        value: |r| r.subpops.to_string(),
+    },
+    Column {
+        name: "burst",
+        doc: "whether the generation ended in a burst mutation (`true` or `false`)",
+        value: |r| r.burst.to_string(),
+    },
+    Column {
+        name: "bursts",
+        doc: "burst mutations so far",
+        value: |r| r.bursts.to_string(),
+    },
+    Column {
+        name: "lesion",
+        doc: "the lesion test's outcome: `add`, `remove K` or empty",
+        value: |r| match r.lesion {
+            None => String::new(),
+            Some(LesionOutcome::Add) => "add".into(),
+            Some(LesionOutcome::Remove { neuron }) => format!("remove {neuron}"),
+        },
+    },
+];
 
-impl EvolveOutcome {
-    /// Writes the outcome to `path` (a run's `run.json`) atomically.
-    pub fn save(&self, path: &Path) -> Result<()> {
-        let mut json = serde_json::to_string_pretty(self)?;
-        json.push('\n');
-        write_atomic(path, json.as_bytes())
-    }
-}
-
-/// The header line of `records.csv`.
-const RECORDS_HEADER: &str = "generation,min,mean,max,best,champion,evaluations,subpops,burst,bursts,lesion\n";
-
-/// One line of `records.csv`.
+/// One line of `records.csv`, with its line break.
 fn record_line(r: &GenerationRecord) -> String {
-    let best = r.best.map_or(String::new(), |b| b.to_string());
-    let lesion = match r.lesion {
-        None => String::new(),
-        Some(crate::evolution::LesionOutcome::Add) => "add".into(),
-        Some(crate::evolution::LesionOutcome::Remove { neuron }) => format!("remove {neuron}"),
-    };
-    format!(
-        "{},{},{},{},{best},{},{},{},{},{},{lesion}\n",
-        r.generation, r.min, r.mean, r.max, r.champion, r.evaluations, r.subpops, r.burst, r.bursts
-    )
+    row(&RECORD_COLUMNS, r) + "\n"
 }
 
 /// The records as CSV, one row per generation.
 pub fn records_csv(records: &[GenerationRecord]) -> String {
-    let mut csv = String::from(RECORDS_HEADER);
+    let mut csv = header(&RECORD_COLUMNS) + "\n";
     for r in records {
         csv.push_str(&record_line(r));
     }
@@ -122,7 +127,7 @@ struct LiveRecords {
 impl LiveRecords {
     fn create(path: &Path) -> LiveRecords {
         let file = std::fs::File::create(path).and_then(|mut f| {
-            f.write_all(RECORDS_HEADER.as_bytes())?;
+            f.write_all((header(&RECORD_COLUMNS) + "\n").as_bytes())?;
             Ok(f)
         });
         LiveRecords { file: file.ok() }

@@ -9,22 +9,113 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use super::grid::run_dir;
-use super::report::RunData;
+use crate::columns::{csv_field, header, row, Column};
+use crate::results::RunData;
 
 /// The file name, in the grid directory.
 pub const RUNS_CSV: &str = "runs.csv";
 
-/// The header of `runs.csv`.
-pub const RUNS_HEADER: &str = "configuration,task,seed,run_seed,champion_fitness,champion_generation,evaluations,bursts,\
-champion_hidden,clean,input_noise_mean,input_noise_sd,random_init_mean,random_init_sd,backend,tool_version,git_commit,seconds";
+/// The columns of `runs.csv`, one row per finished run; fitness in % of
+/// the task's theoretical maximum, each number as the run's files hold it
+/// (the shortest form that reads back to the same double).
+pub const RUN_COLUMNS: [Column<RunData>; 18] = [
+    Column {
+        name: "configuration",
+        doc: "the configuration (`baseline`, `max-credit`, ...)",
+        value: |run| run.key.config.name().to_string(),
+    },
+    Column {
+        name: "task",
+        doc: "the task, 1 to 3",
+        value: |run| run.key.task.to_string(),
+    },
+    Column {
+        name: "seed",
+        doc: "the grid seed, 1..N",
+        value: |run| run.key.seed.to_string(),
+    },
+    Column {
+        name: "run_seed",
+        doc: "the 64-bit seed the run used, as in `run.json` (`evolve --seed` with it repeats the run)",
+        value: |run| run.summary.seed.to_string(),
+    },
+    Column {
+        name: "champion_fitness",
+        doc: "the champion's fitness",
+        value: |run| run.summary.champion_fitness.to_string(),
+    },
+    Column {
+        name: "champion_generation",
+        doc: "the generation (cycle) the champion was found in",
+        value: |run| run.summary.champion_generation.to_string(),
+    },
+    Column {
+        name: "evaluations",
+        doc: "network evaluations, lesion tests included",
+        value: |run| run.summary.evaluations.to_string(),
+    },
+    Column {
+        name: "bursts",
+        doc: "burst mutations",
+        value: |run| run.summary.bursts.to_string(),
+    },
+    Column {
+        name: "champion_hidden",
+        doc: "hidden neurons of the champion",
+        value: |run| run.summary.champion_hidden.to_string(),
+    },
+    Column {
+        name: "clean",
+        doc: "the champion flown once without noise from the standard start",
+        value: |run| run.robustness.clean.to_string(),
+    },
+    Column {
+        name: "input_noise_mean",
+        doc: "its mean fitness under input noise",
+        value: |run| run.robustness.input_noise.mean.to_string(),
+    },
+    Column {
+        name: "input_noise_sd",
+        doc: "the standard deviation of that fitness",
+        value: |run| run.robustness.input_noise.sd.to_string(),
+    },
+    Column {
+        name: "random_init_mean",
+        doc: "its mean fitness from random initial conditions (empty for task 2)",
+        value: |run| run.robustness.random_init.map_or(String::new(), |s| s.mean.to_string()),
+    },
+    Column {
+        name: "random_init_sd",
+        doc: "the standard deviation of that fitness (empty for task 2)",
+        value: |run| run.robustness.random_init.map_or(String::new(), |s| s.sd.to_string()),
+    },
+    Column {
+        name: "backend",
+        doc: "the physics backend",
+        value: |run| run.summary.backend.name().to_string(),
+    },
+    Column {
+        name: "tool_version",
+        doc: "the version of psa-esp that made the run",
+        value: |run| csv_field(&run.summary.build.tool_version),
+    },
+    Column {
+        name: "git_commit",
+        doc: "its git commit (`-dirty` for uncommitted changes)",
+        value: |run| csv_field(&run.summary.build.git_commit),
+    },
+    Column {
+        name: "seconds",
+        doc: "the run's wall time",
+        value: |run| run.summary.seconds.to_string(),
+    },
+];
 
-/// `runs.csv` for `runs`: fitness in % of the theoretical maximum, each
-/// number as written in the run's files (shortest round-trip form); the
-/// random-initialisation columns are empty for task 2.
+/// `runs.csv` for `runs` ([`RUN_COLUMNS`]).
 pub fn runs_csv(runs: &[RunData]) -> String {
-    let mut csv = format!("{RUNS_HEADER}\n");
+    let mut csv = header(&RUN_COLUMNS) + "\n";
     for run in runs {
-        csv.push_str(&run_row(run));
+        csv.push_str(&row(&RUN_COLUMNS, run));
         csv.push('\n');
     }
     csv
@@ -50,7 +141,7 @@ pub fn sweep_runs_csv(keys: &[String], variants: &[VariantRuns]) -> Result<Strin
         csv.push(',');
         csv.push_str(&csv_field(key));
     }
-    let _ = writeln!(csv, ",{RUNS_HEADER}");
+    let _ = writeln!(csv, ",{}", header(&RUN_COLUMNS));
     for variant in variants {
         for run in variant.runs {
             let path = run_dir(variant.dir, &run.key).join("config.toml");
@@ -63,7 +154,7 @@ pub fn sweep_runs_csv(keys: &[String], variants: &[VariantRuns]) -> Result<Strin
                 csv.push(',');
                 csv.push_str(&csv_field(&setting_text(&config, key)));
             }
-            let _ = writeln!(csv, ",{}", run_row(run));
+            let _ = writeln!(csv, ",{}", row(&RUN_COLUMNS, run));
         }
     }
     Ok(csv)
@@ -84,52 +175,9 @@ fn setting_text(config: &toml::Table, key: &str) -> String {
     }
 }
 
-/// The columns of [`RUNS_HEADER`] for one run.
-fn run_row(run: &RunData) -> String {
-    let r = &run.robustness;
-    let (init_mean, init_sd) = r.random_init.map_or((String::new(), String::new()), |s| {
-        (s.mean.to_string(), s.sd.to_string())
-    });
-    format!(
-        "{},{},{},{},{},{},{},{},{},{},{},{},{init_mean},{init_sd},{},{},{},{}",
-        run.key.config.name(),
-        run.key.task,
-        run.key.seed,
-        run.run_seed,
-        run.champion,
-        run.champion_generation,
-        run.evaluations,
-        run.bursts,
-        run.champion_hidden,
-        r.clean,
-        r.input_noise.mean,
-        r.input_noise.sd,
-        run.backend.name(),
-        csv_field(&run.build.tool_version),
-        csv_field(&run.build.git_commit),
-        run.seconds,
-    )
-}
-
-/// `text` as one CSV field: quoted when it holds a comma, quote or line break.
-fn csv_field(text: &str) -> String {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fields_with_commas_or_quotes_are_quoted() {
-        assert_eq!(csv_field("abc123-dirty"), "abc123-dirty");
-        assert_eq!(csv_field("a,b"), "\"a,b\"");
-        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
-    }
 
     #[test]
     fn a_dotted_key_reads_its_value_in_toml_form_and_a_missing_one_is_empty() {

@@ -12,9 +12,10 @@
 
 use serde::Serialize;
 
-use super::paper::{paper_bursts, paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK};
+use super::paper::{paper_bursts, paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK, PAPER_TASKS};
 use super::{GridResults, Metric};
 use crate::psa::Task;
+use crate::BASELINE;
 use crate::{GridConfig, Preset};
 
 /// One term of the distance.
@@ -43,8 +44,6 @@ pub struct Distance {
     pub missing: Vec<String>,
 }
 
-const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
-
 impl Distance {
     /// The distance of `results` to the paper.
     pub fn of(results: &GridResults) -> Distance {
@@ -70,8 +69,8 @@ impl Distance {
             ("Table 2 random init", Metric::RandomInit),
         ];
         for (label, metric) in [("Table 1", Metric::Champion)].into_iter().chain(table2) {
-            for task in Task::ALL {
-                if let Some(cell) = paper_cell(BASELINE, metric, Some(task.number())) {
+            for task in PAPER_TASKS {
+                if let Some(cell) = paper_cell(BASELINE, metric, Some(task)) {
                     add(
                         format!("{label} task {task}"),
                         mean_of(BASELINE, task, metric),
@@ -83,9 +82,9 @@ impl Distance {
         }
         for config in [BASELINE, GridConfig::Preset(Preset::MaxCredit)] {
             let paper = paper_bursts(config).expect("the paper gives both burst totals") as f64;
-            // The paper's total is over all three tasks: only a grid with all of them compares.
-            let runs: Vec<f64> = results.values(config, &Task::ALL, Metric::Bursts);
-            let all_tasks = Task::ALL
+            // The paper's total is over its three tasks: only a grid with all of them compares.
+            let runs: Vec<f64> = results.values(config, &PAPER_TASKS, Metric::Bursts);
+            let all_tasks = PAPER_TASKS
                 .iter()
                 .all(|&t| results.runs_of(config, &[t]).next().is_some());
             let here = (all_tasks && !runs.is_empty())

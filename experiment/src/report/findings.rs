@@ -3,11 +3,13 @@
 
 use serde::Serialize;
 
-use super::paper::{paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK};
-use super::tables::paper_bursts_per_run;
+use super::paper::{
+    paper_bursts_per_run, paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_ALL, PAPER_RUNS_PER_TASK, PAPER_TASKS,
+};
 use super::{GridResults, Metric};
 use crate::psa::Task;
 use crate::stats::{mean_sd, welch};
+use crate::BASELINE;
 use crate::{GridConfig, Preset};
 
 /// Significance level of the Welch rules.
@@ -135,8 +137,6 @@ pub struct Finding {
     pub verdict: Verdict,
 }
 
-const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
-
 impl Finding {
     fn new(claim: &str, measure: &str, rule: Rule, paper: Vec<Comparison>, here: Vec<Comparison>) -> Finding {
         let judge = |cs: &[Comparison]| -> Verdict {
@@ -185,7 +185,7 @@ fn paper(label: &str, n: usize, a: f64, b: f64, p: f64) -> Comparison {
 
 /// The paper's mean of `config`'s champions under `metric` over `tasks`
 /// (equal runs per task, so the mean of the task means).
-fn paper_mean(config: GridConfig, metric: Metric, tasks: &[u8]) -> f64 {
+fn paper_mean(config: GridConfig, metric: Metric, tasks: &[Task]) -> f64 {
     let means: Vec<f64> = tasks
         .iter()
         .map(|&t| paper_cell(config, metric, Some(t)).map_or(f64::NAN, |c| c.mean))
@@ -198,7 +198,7 @@ pub fn findings(results: &GridResults) -> Vec<Finding> {
     let tasks = &results.spec.tasks;
     let champions = |config: GridConfig| results.values(config, tasks, Metric::Champion);
     let base = champions(BASELINE);
-    let all = PAPER_RUNS_PER_TASK * 3;
+    let all = PAPER_RUNS_ALL;
     let mut out: Vec<Finding> = [
         (
             Preset::MaxCredit,
@@ -264,7 +264,8 @@ fn robustness_findings(results: &GridResults) -> Vec<Finding> {
     let tasks = &results.spec.tasks;
     let random_tasks: Vec<Task> = tasks.iter().copied().filter(|t| t.has_random_init()).collect();
     let v = |config: GridConfig, tasks: &[Task], metric: Metric| results.values(config, tasks, metric);
-    let all = PAPER_RUNS_PER_TASK * 3;
+    let all = PAPER_RUNS_ALL;
+    let paper_random: Vec<Task> = PAPER_TASKS.into_iter().filter(|t| t.has_random_init()).collect();
     let noise_all = paper_cell(BASELINE, Metric::InputNoise, None).map_or(f64::NAN, |c| c.mean);
     let clean_all = paper_cell(BASELINE, Metric::Clean, None).map_or(f64::NAN, |c| c.mean);
     // Tasks 1 and 2, both tested under input noise.
@@ -275,8 +276,8 @@ fn robustness_findings(results: &GridResults) -> Vec<Finding> {
             .map(|&t| {
                 let label = format!("task {t}");
                 let (a, b) = (
-                    paper_cell(GridConfig::InputNoise, source, Some(t.number())),
-                    paper_cell(BASELINE, source, Some(t.number())),
+                    paper_cell(GridConfig::InputNoise, source, Some(t)),
+                    paper_cell(BASELINE, source, Some(t)),
                 );
                 let here = compare(
                     &label,
@@ -312,9 +313,9 @@ fn robustness_findings(results: &GridResults) -> Vec<Finding> {
             Rule::Collapse,
             vec![paper(
                 "tasks 1 and 3",
-                2 * PAPER_RUNS_PER_TASK,
-                paper_mean(BASELINE, Metric::RandomInit, &[1, 3]),
-                paper_mean(BASELINE, Metric::Clean, &[1, 3]),
+                PAPER_RUNS_PER_TASK * paper_random.len(),
+                paper_mean(BASELINE, Metric::RandomInit, &paper_random),
+                paper_mean(BASELINE, Metric::Clean, &paper_random),
                 f64::NAN,
             )],
             vec![compare(

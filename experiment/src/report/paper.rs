@@ -5,6 +5,7 @@
 use serde::Serialize;
 
 use super::Metric;
+use crate::psa::Task;
 use crate::{GridConfig, Preset};
 
 /// One cell of a paper table.
@@ -18,8 +19,13 @@ pub struct PaperCell {
     pub p: Option<f64>,
 }
 
+/// The paper's tasks, in the order of its tables' columns (then All).
+/// [`Task::in_paper`] holds exactly these.
+pub const PAPER_TASKS: [Task; 3] = [Task::StopRotation, Task::Turn, Task::StopAtPosition];
 /// Champions per task in the paper.
 pub const PAPER_RUNS_PER_TASK: usize = 30;
+/// Champions over all of the paper's tasks (its "All" column).
+pub const PAPER_RUNS_ALL: usize = PAPER_RUNS_PER_TASK * PAPER_TASKS.len();
 /// Burst mutations over the paper's 90 runs (3 tasks x 30 seeds): baseline, max credit.
 pub const PAPER_BURSTS: [(GridConfig, usize); 2] = [
     (GridConfig::Preset(Preset::Baseline), 2448),
@@ -39,7 +45,7 @@ const fn c(mean: f64, sd: f64, p: f64) -> Option<PaperCell> {
 /// No p (the baseline itself, and the robustness tables).
 const N: f64 = -1.0;
 
-/// Champion fitness, tasks 1, 2, 3 and All (Tables 1 and 4-7).
+/// Champion fitness, the [`PAPER_TASKS`] and All (Tables 1 and 4-7).
 const CHAMPIONS: [(Preset, [Option<PaperCell>; 4]); 6] = [
     (
         Preset::Baseline,
@@ -93,7 +99,7 @@ const CHAMPIONS: [(Preset, [Option<PaperCell>; 4]); 6] = [
 ];
 
 /// Robustness (Tables 2 and 3): the configuration whose champions are
-/// tested, the test, tasks 1, 2, 3 and All.
+/// tested, the test, the [`PAPER_TASKS`] and All.
 const ROBUSTNESS: [(GridConfig, Metric, [Option<PaperCell>; 4]); 4] = [
     (
         GridConfig::Preset(Preset::Baseline),
@@ -117,10 +123,14 @@ const ROBUSTNESS: [(GridConfig, Metric, [Option<PaperCell>; 4]); 4] = [
     ),
 ];
 
-/// The paper's cell for `config`'s champions under `metric` on task `task` (1-3; `None`
-/// for All), if the paper has one.
-pub fn paper_cell(config: GridConfig, metric: Metric, task: Option<u8>) -> Option<PaperCell> {
-    let column = task.map_or(3, |t| usize::from(t) - 1);
+/// The paper's cell for `config`'s champions under `metric` on `task`
+/// (`None` for All), if the paper has one: none for a task the paper did
+/// not run.
+pub fn paper_cell(config: GridConfig, metric: Metric, task: Option<Task>) -> Option<PaperCell> {
+    let column = match task {
+        None => PAPER_TASKS.len(),
+        Some(task) => PAPER_TASKS.iter().position(|&t| t == task)?,
+    };
     let row = match (config, metric) {
         // Table 1 is also the clean fitness of the baseline champions (Table 2).
         (GridConfig::Preset(p), Metric::Champion) | (GridConfig::Preset(p @ Preset::Baseline), Metric::Clean) => {
@@ -137,4 +147,21 @@ pub fn paper_cell(config: GridConfig, metric: Metric, task: Option<u8>) -> Optio
 /// The paper's burst total over [`PAPER_BURST_RUNS`] runs for `config`.
 pub fn paper_bursts(config: GridConfig) -> Option<usize> {
     PAPER_BURSTS.iter().find(|(c, _)| *c == config).map(|(_, n)| *n)
+}
+
+/// The paper's burst total per run for `config`, for the report's text.
+pub fn paper_bursts_per_run(config: GridConfig) -> Option<f64> {
+    paper_bursts(config).map(|n| n as f64 / PAPER_BURST_RUNS as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_papers_tasks_are_those_the_task_says_are_in_the_paper() {
+        let in_paper: Vec<Task> = Task::ALL.into_iter().filter(|t| t.in_paper()).collect();
+        assert_eq!(in_paper, PAPER_TASKS);
+        assert_eq!(PAPER_BURST_RUNS, PAPER_RUNS_ALL);
+    }
 }

@@ -13,16 +13,15 @@ use serde::Serialize;
 
 use super::distance::Distance;
 use super::findings::Verdict;
+use super::paper::PAPER_TASKS;
 use super::render::num;
 use super::tables::Report;
 use super::{GridResults, Metric};
 use crate::grid::grid_file;
-use crate::psa::Task;
 use crate::runs_table::{sweep_runs_csv, VariantRuns, RUNS_CSV};
 use crate::sweep::{variant_dir, SweepSpec};
+use crate::BASELINE;
 use crate::{GridConfig, Preset};
-
-const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
 
 /// One variant's summary.
 #[derive(Debug, Clone, Serialize)]
@@ -97,7 +96,7 @@ impl VariantSummary {
             name,
             settings,
             runs: (results.runs.len(), results.spec.runs().len()),
-            table1: Task::ALL.map(|t| mean(&results.values(BASELINE, &[t], Metric::Champion))),
+            table1: PAPER_TASKS.map(|t| mean(&results.values(BASELINE, &[t], Metric::Champion))),
             bursts_per_run: [per_run(BASELINE), per_run(GridConfig::Preset(Preset::MaxCredit))],
             noise_ratio: ratio(Metric::InputNoise),
             random_init_ratio: ratio(Metric::RandomInit),

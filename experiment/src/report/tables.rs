@@ -7,15 +7,14 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::findings::{findings, Finding};
-use super::paper::{paper_bursts, paper_cell, PaperCell, PAPER_BURST_RUNS};
+use super::paper::{paper_bursts, paper_cell, PaperCell};
 use super::{GridResults, Metric, Problem};
 use crate::grid::{GridPreset, GridSpec, RunStatus};
 use crate::provenance::BuildInfo;
 use crate::psa::Task;
 use crate::stats::{mean_sd, welch};
+use crate::BASELINE;
 use crate::{GridConfig, Preset};
-
-const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
 
 /// One row of a table: a configuration's champions on a task (or All).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -185,7 +184,7 @@ impl Report {
             grid: spec.clone(),
             reduced: reductions(spec),
             builds: builds(results),
-            compute_seconds: results.runs.iter().map(|r| r.seconds).sum(),
+            compute_seconds: results.runs.iter().map(|r| r.summary.seconds).sum(),
             runs_expected: spec.runs().len(),
             runs_counted: results.runs.len(),
             missing: missing_cells(results),
@@ -208,10 +207,10 @@ impl Report {
 }
 
 /// The task columns: each task alone, then All (the grid's tasks pooled).
-fn task_columns(spec: &GridSpec) -> Vec<(String, Vec<Task>, Option<u8>)> {
+fn task_columns(spec: &GridSpec) -> Vec<(String, Vec<Task>, Option<Task>)> {
     let mut columns: Vec<_> = Task::ALL
         .iter()
-        .map(|&t| (t.number().to_string(), vec![t], Some(t.number())))
+        .map(|&t| (t.number().to_string(), vec![t], Some(t)))
         .collect();
     columns.push(("All".into(), spec.tasks.clone(), None));
     columns
@@ -222,7 +221,7 @@ fn row(
     results: &GridResults,
     config: GridConfig,
     metric: Metric,
-    (label, tasks, paper_task): &(String, Vec<Task>, Option<u8>),
+    (label, tasks, paper_task): &(String, Vec<Task>, Option<Task>),
     reference: Option<(GridConfig, Metric)>,
 ) -> Row {
     let values = results.values(config, tasks, metric);
@@ -369,7 +368,7 @@ pub(super) fn reductions(spec: &GridSpec) -> Vec<String> {
 fn builds(results: &GridResults) -> Vec<BuildCount> {
     let mut counts: BTreeMap<&BuildInfo, usize> = BTreeMap::new();
     for run in &results.runs {
-        *counts.entry(&run.build).or_default() += 1;
+        *counts.entry(&run.summary.build).or_default() += 1;
     }
     counts
         .into_iter()
@@ -410,9 +409,4 @@ fn missing_cells(results: &GridResults) -> Vec<MissingCell> {
         }
     }
     cells
-}
-
-/// The paper's burst totals per run, for the report's text.
-pub(super) fn paper_bursts_per_run(config: GridConfig) -> Option<f64> {
-    paper_bursts(config).map(|n| n as f64 / PAPER_BURST_RUNS as f64)
 }

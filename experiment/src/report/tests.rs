@@ -3,14 +3,15 @@
 use std::path::{Path, PathBuf};
 
 use super::*;
-use crate::grid::{GridPreset, GridSpec};
+use crate::grid::{GridPreset, GridSpec, FINISHED_MARKER};
 use crate::network::Network;
 use crate::physics::BackendKind;
 use crate::psa::NetworkFile;
-use crate::robustness::TrialSummary;
+use crate::results::{parse_records, GenerationRow};
+use crate::robustness::{Robustness, TrialSummary};
 use crate::Preset;
+use crate::BASELINE;
 
-const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
 const MAX_CREDIT: GridConfig = GridConfig::Preset(Preset::MaxCredit);
 
 /// Baseline, max credit and input noise on tasks 1 and 2, seeds 1-3 (18 runs), 4 generations.

@@ -34,6 +34,15 @@ impl Task {
     pub fn has_random_init(self) -> bool {
         self != Task::Turn
     }
+
+    /// Whether the paper ran this task (its tables have a column for it): a
+    /// grid's default tasks and the report's comparisons with the paper ask
+    /// this, never [`Task::ALL`]. A task added later answers `false`.
+    pub fn in_paper(self) -> bool {
+        match self {
+            Task::StopRotation | Task::Turn | Task::StopAtPosition => true,
+        }
+    }
 }
 
 impl TryFrom<u8> for Task {
