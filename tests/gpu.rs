@@ -50,9 +50,6 @@ fn the_gpu_gives_the_scalar_paths_bits() -> Result<(), Failed> {
 fn small_grid(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::process::Output {
     let out = out.to_str().unwrap();
     let mut command = std::process::Command::new(common::binary());
-    if let Some(path) = path {
-        command.args(["--eval-path", path]);
-    }
     command.args([
         "replicate",
         "--preset",
@@ -74,6 +71,9 @@ fn small_grid(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::
         "--out",
         out,
     ]);
+    if let Some(path) = path {
+        command.args(["--eval-path", path]);
+    }
     command.output().unwrap()
 }
 
