@@ -42,7 +42,7 @@ pub enum EvalPath {
 }
 
 impl EvalPath {
-    /// The names [`EvalPath::from_str`] reads: every path but
+    /// The names `EvalPath` is read from (its `FromStr`): every path but
     /// [`EvalPath::Kernel`], which needs a device.
     pub const NAMES: [&'static str; 7] = [
         "fastest",
@@ -83,11 +83,12 @@ impl std::str::FromStr for EvalPath {
 }
 
 /// Scores a network by its fitness on a task (in % of the theoretical
-/// maximum, the mean over `settings.trials` trials). Each worker thread
-/// owns its physics worlds, reused between evaluations. On the `native`
-/// backend, networks are evaluated in lockstep by the batched SIMD path
-/// ([`BatchRunner`]); on `ode`, in lockstep as bodies of one world
-/// ([`OdeLockstepRunner`]). Both give the scalar path's results bit for bit.
+/// maximum, the mean over `settings.trials` trials), on the [`EvalPath`] it
+/// was made with: on `native` the batched SIMD path ([`BatchRunner`]) or a
+/// kernel, on `ode` the lockstep path ([`OdeLockstepRunner`]), or one
+/// network at a time. Each worker thread owns its physics worlds, reused
+/// between evaluations. Every path gives the scalar path's results bit for
+/// bit.
 #[derive(Debug, Clone)]
 pub struct PsaEvaluator {
     settings: PsaSettings,
