@@ -1,6 +1,6 @@
 //! One recorded trial as the pictures see it ([`TrialPicture`]), and what
 //! the static figure ([`super::trial`]) and the animation
-//! ([`super::animation`]) share: the thrusters' names and colours, and the
+//! (`animation.rs`) share: the thrusters' names and colours, and the
 //! equal-aspect view of the x-y plane.
 
 use anyhow::{bail, ensure};
