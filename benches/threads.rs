@@ -7,7 +7,8 @@
 //! prints it, with the machine.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use psa_esp::cli::bench::{machine, random_networks, EvaluationPath};
+use psa_esp::cli::bench::{machine, EvaluationPath};
+use psa_esp::cli::bench_networks::random_networks;
 use psa_esp::cli::bench_runs::{evolve_workload, replicate_workload};
 use psa_esp::evolution::evaluate_all;
 use psa_esp::ode::thread_pool;

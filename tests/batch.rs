@@ -233,8 +233,8 @@ fn the_batched_path_refuses_other_backends_and_bad_networks() {
 
 #[test]
 fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
+    use psa_esp::evaluator::{EvalPath, PsaEvaluator};
     use psa_esp::evolution::{Esp, EspSettings};
-    use psa_esp::experiment::PsaEvaluator;
     let settings = native(PsaSettings::default());
     let esp = Esp::new(
         EspSettings {
@@ -247,9 +247,8 @@ fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
     )
     .unwrap();
     let run = |level: Option<SimdLevel>, threads: usize| {
-        let evaluator = PsaEvaluator::new(settings.clone(), Task::StopAtPosition)
-            .unwrap()
-            .with_batching(level);
+        let path = level.map_or(EvalPath::Scalar, EvalPath::Simd);
+        let evaluator = PsaEvaluator::new(settings.clone(), Task::StopAtPosition, &path).unwrap();
         let pool = psa_esp::ode::thread_pool(threads).unwrap();
         let result = pool.install(|| esp.run(&evaluator, |_| {})).unwrap();
         (

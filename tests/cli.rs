@@ -21,7 +21,7 @@ fn stderr(o: &Output) -> String {
 fn version_names_the_commit_and_the_libode_version() {
     let o = psa_esp(&["--version"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let info = psa_esp::provenance::build_info();
+    let info = psa_esp::experiment::build_info();
     assert_eq!(
         stdout(&o).trim(),
         format!(
@@ -188,9 +188,15 @@ fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
     // the spin stops); the file records that model, and replay flies on it.
     let mut model = PsaSettings::default();
     model.tasks.task1_spin = 1.0;
-    NetworkFile::new(&spin_damper(), Task::StopRotation, &model, serde_json::Map::new())
-        .save(&net_path)
-        .unwrap();
+    NetworkFile::new(
+        &spin_damper(),
+        Task::StopRotation,
+        &model,
+        &psa_esp::experiment::build_info(),
+        serde_json::Map::new(),
+    )
+    .save(&net_path)
+    .unwrap();
     let out = dir.path().join("replay");
     let o = psa_esp(&[
         "replay",

@@ -24,7 +24,6 @@ use libtest_mimic::{Arguments, Failed, Trial};
 /// Set (as CI does), the NVRTC test runs, and fails, where NVRTC is missing
 /// instead of being ignored.
 const REQUIRE_NVRTC: &str = "PSA_ESP_REQUIRE_NVRTC";
-use psa_esp::experiment::{KERNEL_ON_HOST, SIMD_VARIABLE};
 use psa_esp::psa::cuda::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME};
 
 fn nvrtc_compiles_the_trial_kernel() -> Result<(), Failed> {
@@ -47,13 +46,10 @@ fn the_gpu_gives_the_scalar_paths_bits() -> Result<(), Failed> {
 }
 
 /// A small grid with noise and random starts: `replicate` on `backend`,
-/// with `PSA_ESP_SIMD` set to `path`, if given.
+/// with `--eval-path path`, if given.
 fn small_grid(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::process::Output {
     let out = out.to_str().unwrap();
     let mut command = std::process::Command::new(common::binary());
-    if let Some(path) = path {
-        command.env(SIMD_VARIABLE, path);
-    }
     command.args([
         "replicate",
         "--preset",
@@ -75,11 +71,14 @@ fn small_grid(backend: &str, out: &std::path::Path, path: Option<&str>) -> std::
         "--out",
         out,
     ]);
+    if let Some(path) = path {
+        command.args(["--eval-path", path]);
+    }
     command.output().unwrap()
 }
 
 /// Asserts that the small grid writes the same files run as `a` and as
-/// `b`, each a `--backend` and a `PSA_ESP_SIMD` value, if any.
+/// `b`, each a `--backend` and an `--eval-path`, if any.
 fn assert_same_grids(a: (&str, Option<&str>), b: (&str, Option<&str>)) -> Result<(), Failed> {
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let outs = [dir.path().join("a"), dir.path().join("b")];
@@ -95,11 +94,11 @@ fn assert_same_grids(a: (&str, Option<&str>), b: (&str, Option<&str>)) -> Result
 }
 
 /// The GPU path's plumbing without a GPU: the small grid in lockstep with
-/// every trial flown by the kernel built for the host (`PSA_ESP_SIMD=kernel-host`,
+/// every trial flown by the kernel built for the host (`--eval-path kernel-host`,
 /// a round's networks of a configuration and task per call, as a GPU gets
 /// them) against `native`, file for file.
 fn the_kernel_path_on_the_host_gives_the_native_grid() -> Result<(), Failed> {
-    assert_same_grids(("native", None), ("native", Some(KERNEL_ON_HOST)))
+    assert_same_grids(("native", None), ("native", Some("kernel-host")))
 }
 
 fn the_gpu_grid_is_byte_identical_to_native() -> Result<(), Failed> {
@@ -110,8 +109,16 @@ fn the_gpu_grid_is_byte_identical_to_native() -> Result<(), Failed> {
 /// for the GPU: a row per size, beside `native`.
 fn the_bench_times_the_kernel_beside_native() -> Result<(), Failed> {
     let output = std::process::Command::new(common::binary())
-        .env(SIMD_VARIABLE, KERNEL_ON_HOST)
-        .args(["bench", "--steps", "500", "--rounds", "1", "--networks", "16"])
+        .args([
+            "bench",
+            "--kernel-host",
+            "--steps",
+            "500",
+            "--rounds",
+            "1",
+            "--networks",
+            "16",
+        ])
         .args(["--generations", "2", "--kernel-networks", "8,24", "--json"])
         .output()
         .map_err(|e| e.to_string())?;

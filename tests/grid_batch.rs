@@ -8,7 +8,7 @@ use std::process::{Command, Stdio};
 
 use common::{assert_same_runs, finished_lines, psa_esp, tiny_grid};
 use psa_esp::experiment::grid::GridSpec;
-use psa_esp::experiment::replicate::run_seed;
+use psa_esp::experiment::grid_run::run_seed;
 
 fn args(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()

@@ -174,9 +174,15 @@ fn save_network(path: &Path, scaling: SensorSettings) {
         sensors: scaling,
         ..PsaSettings::default()
     };
-    NetworkFile::new(&network, Task::StopRotation, &problem, serde_json::Map::new())
-        .save(path)
-        .unwrap();
+    NetworkFile::new(
+        &network,
+        Task::StopRotation,
+        &problem,
+        &psa_esp::experiment::build_info(),
+        serde_json::Map::new(),
+    )
+    .save(path)
+    .unwrap();
 }
 
 /// Every row of the suite.

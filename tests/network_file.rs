@@ -24,7 +24,13 @@ fn save_and_load_round_trip_exactly() {
     let net = sample_network();
     let mut extra = serde_json::Map::new();
     extra.insert("seed".into(), 42.into());
-    let file = NetworkFile::new(&net, Task::StopAtPosition, &PsaSettings::default(), extra);
+    let file = NetworkFile::new(
+        &net,
+        Task::StopAtPosition,
+        &PsaSettings::default(),
+        &psa_esp::experiment::build_info(),
+        extra,
+    );
     file.save(&path).unwrap();
     let (loaded_file, loaded) = NetworkFile::load(&path).unwrap();
     assert_eq!(loaded, net);
@@ -50,6 +56,7 @@ fn valid_json() -> serde_json::Value {
         &sample_network(),
         Task::Turn,
         &PsaSettings::default(),
+        &psa_esp::experiment::build_info(),
         serde_json::Map::new(),
     );
     serde_json::to_value(&file).unwrap()

@@ -242,8 +242,8 @@ fn a_fleet_checks_every_command_and_state_before_calling_ode() {
 
 #[test]
 fn an_esp_run_on_ode_is_the_same_in_lockstep_and_one_world_per_network_on_any_thread_count() {
+    use psa_esp::evaluator::{EvalPath, PsaEvaluator};
     use psa_esp::evolution::{Esp, EspSettings};
-    use psa_esp::experiment::PsaEvaluator;
     let settings = PsaSettings {
         steps: 150,
         ..PsaSettings::default()
@@ -259,9 +259,12 @@ fn an_esp_run_on_ode_is_the_same_in_lockstep_and_one_world_per_network_on_any_th
     )
     .unwrap();
     let run = |lockstep: bool, threads: usize| {
-        let evaluator = PsaEvaluator::new(settings.clone(), Task::StopAtPosition)
-            .unwrap()
-            .with_ode_lockstep(lockstep);
+        let path = if lockstep {
+            EvalPath::OdeLockstep
+        } else {
+            EvalPath::Scalar
+        };
+        let evaluator = PsaEvaluator::new(settings.clone(), Task::StopAtPosition, &path).unwrap();
         let pool = psa_esp::ode::thread_pool(threads).unwrap();
         let result = pool.install(|| esp.run(&evaluator, |_| {})).unwrap();
         (

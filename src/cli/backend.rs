@@ -2,9 +2,10 @@
 //! the `native` backend's physics with every trial flown on the GPU.
 
 use anyhow::Result;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
 use std::sync::Arc;
 
-use crate::experiment::fly_trials_on;
+use crate::evaluator::EvalPath;
 use crate::physics::BackendKind;
 use crate::psa::cuda::CudaTrials;
 
@@ -33,16 +34,36 @@ impl BackendArg {
         }
     }
 
-    /// For `cuda`: opens the GPU, compiles the kernel and makes every
-    /// evaluator of the process use it, printing the device to standard
-    /// error; an error naming what is missing (the feature, the driver,
-    /// NVRTC or a device) where it cannot. Nothing for the others.
-    pub fn prepare(self) -> Result<()> {
-        if self == BackendArg::Cuda {
-            let gpu = CudaTrials::open().map_err(|e| anyhow::anyhow!("--backend cuda: {e}"))?;
-            eprintln!("evaluating on {}", gpu.device());
-            fly_trials_on(Arc::new(gpu));
+    /// The evaluation path of the runs: for `cuda` the GPU (opened, the
+    /// kernel compiled, the device printed to standard error; an error
+    /// naming what is missing, the feature, the driver, NVRTC or a device,
+    /// where it cannot be), else `requested` (`--eval-path`).
+    pub fn eval_path(backend: Option<BackendArg>, requested: EvalPath) -> Result<EvalPath> {
+        if backend != Some(BackendArg::Cuda) {
+            return Ok(requested);
         }
-        Ok(())
+        if !matches!(requested, EvalPath::Fastest) {
+            anyhow::bail!("--backend cuda flies every trial on the GPU: leave out --eval-path");
+        }
+        let gpu = CudaTrials::open().map_err(|e| anyhow::anyhow!("--backend cuda: {e}"))?;
+        eprintln!("evaluating on {}", gpu.device());
+        Ok(EvalPath::Kernel(Arc::new(gpu)))
     }
+}
+
+/// `--eval-path` of the commands that evolve.
+#[derive(Debug, Clone, clap::Args)]
+pub struct EvalPathArg {
+    /// Where the networks are evaluated: fastest (on native the processor's
+    /// best SIMD level, on ode the lockstep path), scalar (the reference),
+    /// a SIMD level of native (portable, avx2, avx512), ode-lockstep, or
+    /// kernel-host (native's trials through the cuda kernel built for the
+    /// host, slowly). Results do not depend on it.
+    #[arg(long, value_parser = eval_path_parser(), default_value = "fastest")]
+    pub eval_path: EvalPath,
+}
+
+/// The parser of `--eval-path`: one of [`EvalPath::NAMES`].
+fn eval_path_parser() -> impl TypedValueParser<Value = EvalPath> {
+    PossibleValuesParser::new(EvalPath::NAMES).map(|name| name.parse().expect("clap admits only the names"))
 }

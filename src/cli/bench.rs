@@ -15,18 +15,15 @@ use multiversion::multiversion;
 use serde::Serialize;
 
 use super::bench_kernel::{kernel_rows, KERNEL_NETWORKS};
+use super::bench_networks::{random_networks, HIDDEN};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
+use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::evaluate_all;
-use crate::evolution::operators::random_genes;
-use crate::experiment::PsaEvaluator;
 use crate::network::Network;
 use crate::numeric::{sigmoid, Lanes, SimdLevel};
 use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
 use crate::psa::batch::LANES;
-use crate::psa::{BodySettings, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
-
-/// Hidden neurons of the benchmark's networks (the paper's 7-5-4 network).
-const HIDDEN: usize = 5;
+use crate::psa::{BodySettings, PsaSettings, Task, THRUSTER_COUNT};
 
 /// Arguments of `bench`.
 #[derive(Debug, clap::Args)]
@@ -46,10 +43,14 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(2..=100_000))]
     pub generations: u64,
     /// Networks per launch of the cuda kernel's rows, beside `native`
-    /// (measured only where a GPU is, or with PSA_ESP_SIMD=kernel-host).
+    /// (measured only where a GPU is, or with --kernel-host).
     #[arg(long, value_delimiter = ',', default_values_t = KERNEL_NETWORKS,
           value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub kernel_networks: Vec<u64>,
+    /// Time the cuda kernel's rows on the kernel built for the host instead
+    /// of a GPU (the rows' plumbing without one, slowly).
+    #[arg(long)]
+    pub kernel_host: bool,
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
@@ -118,9 +119,12 @@ impl EvaluationPath {
             backend: self.backend,
             ..PsaSettings::default()
         };
-        Ok(PsaEvaluator::new(settings, Task::StopRotation)?
-            .with_batching(self.simd)
-            .with_ode_lockstep(self.ode_lockstep))
+        let path = match (self.simd, self.ode_lockstep) {
+            (Some(level), _) => EvalPath::Simd(level),
+            (None, true) => EvalPath::OdeLockstep,
+            (None, false) => EvalPath::Scalar,
+        };
+        PsaEvaluator::new(settings, Task::StopRotation, &path)
     }
 }
 
@@ -132,20 +136,6 @@ struct EvaluationTiming {
     evaluations_per_second_2_threads: f64,
     speedup_2_threads: f64,
     ns_per_network_step_1_thread: f64,
-}
-
-/// Random 7-5-4 networks, weights uniform in (-6, 6) as ESP starts them.
-pub fn random_networks(count: u64) -> Result<Vec<Network>> {
-    let mut rng = crate::rng::stream(1, &[]);
-    (0..count)
-        .map(|_| {
-            Ok(Network::from_genes(
-                INPUT_COUNT,
-                THRUSTER_COUNT,
-                random_genes(&mut rng, HIDDEN * (INPUT_COUNT + THRUSTER_COUNT), 6.0),
-            )?)
-        })
-        .collect()
 }
 
 /// Evaluations per second of `networks` on task 1 with `threads` threads
@@ -350,7 +340,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
     let replicate = replicate_workload(generations)?.scaling(args.rounds)?;
     // Long enough that the set-up before the first generation does not count.
     let overhead = algorithm_overhead(5 * generations, args.rounds)?;
-    let kernel = kernel_rows(&args.kernel_networks, args.rounds)?;
+    let kernel = kernel_rows(&args.kernel_networks, args.rounds, args.kernel_host)?;
     let machine = machine();
     if args.json {
         let out = serde_json::json!({

@@ -8,9 +8,8 @@ use std::time::Instant;
 use anyhow::Result;
 use serde::Serialize;
 
-use super::bench::random_networks;
+use super::bench_networks::random_networks;
 use super::bench_runs::median;
-use crate::experiment::{KERNEL_ON_HOST, SIMD_VARIABLE};
 use crate::network::Network;
 use crate::physics::{BackendKind, PlanarBody};
 use crate::psa::cuda::{prepare, CudaTrials, HostTrials, TrialFlier};
@@ -33,7 +32,7 @@ pub struct KernelTiming {
 /// The kernel rows, or why they could not be measured.
 #[derive(Debug, Clone, Serialize)]
 pub struct KernelBench {
-    /// What flew the trials (the GPU, or the host build with `PSA_ESP_SIMD=kernel-host`).
+    /// What flew the trials (the GPU, or the host build with `--kernel-host`).
     pub device: String,
     /// One row per size; empty where `unavailable` says why.
     pub rows: Vec<KernelTiming>,
@@ -41,10 +40,10 @@ pub struct KernelBench {
     pub unavailable: Option<String>,
 }
 
-/// The GPU, or the kernel built for the host with `PSA_ESP_SIMD=kernel-host`
-/// (to exercise these rows without a GPU), or why neither.
-fn flier() -> std::result::Result<Box<dyn TrialFlier>, String> {
-    if std::env::var(SIMD_VARIABLE).is_ok_and(|v| v == KERNEL_ON_HOST) {
+/// The kernel built for the host where `on_host` (to exercise these rows
+/// without a GPU), else the GPU, or why there is none.
+fn flier(on_host: bool) -> std::result::Result<Box<dyn TrialFlier>, String> {
+    if on_host {
         return Ok(Box::new(HostTrials));
     }
     CudaTrials::open()
@@ -54,9 +53,9 @@ fn flier() -> std::result::Result<Box<dyn TrialFlier>, String> {
 
 /// Times the kernel and `native` at each of `sizes` networks per launch,
 /// `rounds` rounds each (the median is kept). Without a GPU, no row, and
-/// the reason.
-pub fn kernel_rows(sizes: &[u64], rounds: u64) -> Result<KernelBench> {
-    let flier = match flier() {
+/// the reason. `on_host`: the kernel built for the host stands in for the GPU.
+pub fn kernel_rows(sizes: &[u64], rounds: u64, on_host: bool) -> Result<KernelBench> {
+    let flier = match flier(on_host) {
         Ok(flier) => flier,
         Err(why) => {
             return Ok(KernelBench {
@@ -72,7 +71,7 @@ pub fn kernel_rows(sizes: &[u64], rounds: u64) -> Result<KernelBench> {
     };
     let task = Task::StopRotation;
     let body = PlanarBody::new(&settings.body.model()?, &settings.physics)?;
-    // The batched path itself, not an evaluator (which PSA_ESP_SIMD=kernel-host would send to the kernel).
+    // The batched path itself, as the kernel rows compare against it.
     let native = BatchRunner::new(&settings, task)?;
     let mut rows = Vec::new();
     for &size in sizes {

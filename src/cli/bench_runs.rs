@@ -9,10 +9,12 @@ use std::time::Instant;
 use anyhow::Result;
 use serde::Serialize;
 
+use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::{Esp, Evaluator};
 use crate::experiment::grid::{GridPreset, GridSpec};
-use crate::experiment::replicate::{replicate, FinishedRun, GridProgress, ReplicateOptions};
-use crate::experiment::{GridConfig, Preset, PsaEvaluator, RunConfig};
+use crate::experiment::grid_run::FinishedRun;
+use crate::experiment::replicate::{replicate, GridProgress, ReplicateOptions};
+use crate::experiment::{GridConfig, Preset, RunConfig};
 use crate::network::{Network, NetworkSet};
 use crate::physics::BackendKind;
 use crate::psa::Task;
@@ -95,7 +97,7 @@ fn baseline(generations: usize) -> Result<RunConfig> {
 /// One baseline ESP run of task 3 on the default (batched) native path.
 pub fn evolve_workload(generations: usize) -> Result<Workload> {
     let config = baseline(generations)?;
-    let evaluator = PsaEvaluator::new(config.problem.clone(), Task::StopAtPosition)?;
+    let evaluator = PsaEvaluator::new(config.problem.clone(), Task::StopAtPosition, &EvalPath::Fastest)?;
     let esp = Esp::new(config.esp.clone(), 1).map_err(anyhow::Error::msg)?;
     Ok(Workload {
         name: "evolve",
@@ -196,7 +198,7 @@ impl Evaluator for Timed<'_> {
 /// batched) spent outside the evaluator.
 pub fn algorithm_overhead(generations: usize, rounds: u64) -> Result<AlgorithmOverhead> {
     let config = baseline(generations)?;
-    let evaluator = PsaEvaluator::new(config.problem.clone(), Task::StopAtPosition)?;
+    let evaluator = PsaEvaluator::new(config.problem.clone(), Task::StopAtPosition, &EvalPath::Fastest)?;
     let esp = Esp::new(config.esp.clone(), 1).map_err(anyhow::Error::msg)?;
     let pool = crate::ode::thread_pool(1)?;
     let mut shares = Vec::new();

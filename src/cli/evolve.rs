@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::backend::BackendArg;
+use super::backend::{BackendArg, EvalPathArg};
+use super::choice::choice;
 use crate::experiment::{run_evolution, Preset};
 use crate::ode::MAX_THREADS;
 use crate::psa::Task;
@@ -17,7 +18,7 @@ pub struct EvolveArgs {
     #[arg(long)]
     pub task: Task,
     /// The paper's configuration to start from.
-    #[arg(long, value_enum, default_value_t = Preset::Baseline)]
+    #[arg(long, value_parser = choice(&Preset::ALL, Preset::name), default_value_t = Preset::Baseline)]
     pub preset: Preset,
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]
@@ -31,6 +32,9 @@ pub struct EvolveArgs {
     /// Physics backend, overriding the configuration (`cuda`: native's physics on the GPU).
     #[arg(long, value_enum)]
     pub backend: Option<BackendArg>,
+    /// Where the networks are evaluated.
+    #[command(flatten)]
+    pub eval: EvalPathArg,
     /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
     #[arg(long, alias = "jobs", default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=MAX_THREADS as u64))]
     pub threads: u64,
@@ -66,7 +70,7 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
         config.problem.backend = backend.physics();
     }
     config.validate()?;
-    args.backend.map_or(Ok(()), BackendArg::prepare)?;
+    let path = BackendArg::eval_path(args.backend, args.eval.eval_path.clone())?;
     let out = args
         .out
         .clone()
@@ -83,10 +87,18 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
     );
     let pool = crate::ode::thread_pool(args.threads as usize)?;
     let outcome = pool.install(|| {
-        run_evolution(&config, args.preset.name(), args.task, args.seed, &out, |record| {
-            bar.set_position(record.generation as u64);
-            bar.set_message(format!("champion {:.1} %", record.champion));
-        })
+        run_evolution(
+            &config,
+            args.preset.name(),
+            args.task,
+            args.seed,
+            &out,
+            &path,
+            |record| {
+                bar.set_position(record.generation as u64);
+                bar.set_message(format!("champion {:.1} %", record.champion));
+            },
+        )
     })?;
     bar.finish_and_clear();
     if args.json {

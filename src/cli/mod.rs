@@ -11,8 +11,10 @@ macro_rules! say {
 mod backend;
 pub mod bench;
 pub mod bench_kernel;
+pub mod bench_networks;
 pub mod bench_ode;
 pub mod bench_runs;
+mod choice;
 mod crosscheck;
 mod evolve;
 mod replay;
@@ -31,7 +33,7 @@ pub const EXIT_ERROR: i32 = 2;
 
 /// Evolving neural controllers for the Personal Satellite Assistant.
 #[derive(Debug, Parser)]
-#[command(name = "psa-esp", version = crate::provenance::VERSION, about, long_about = None)]
+#[command(name = "psa-esp", version = crate::experiment::version(), about, long_about = None)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]

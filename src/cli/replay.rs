@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
+use super::choice::choice;
 use crate::experiment::robustness::TrialSummary;
 use crate::physics::BackendKind;
 use crate::plots::{write_trial_pictures, TrialPicture};
@@ -23,7 +24,7 @@ pub struct ReplayArgs {
     #[arg(long)]
     pub task: Option<Task>,
     /// Physics backend.
-    #[arg(long, value_enum, default_value_t = BackendKind::Ode)]
+    #[arg(long, value_parser = choice(&BackendKind::ALL, BackendKind::name), default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Standard deviation of Gaussian noise on every input but the bias.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]

@@ -7,12 +7,14 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 
-use super::backend::BackendArg;
+use super::backend::{BackendArg, EvalPathArg};
+use super::choice::choice;
 use super::evolve::progress_bar;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
+use crate::experiment::grid_run::FinishedRun;
 use crate::experiment::lockstep::Executor;
-use crate::experiment::replicate::{describe, replicate, FinishedRun, GridProgress, HeldRun, ReplicateOptions};
+use crate::experiment::replicate::{describe, replicate, GridProgress, HeldRun, ReplicateOptions};
 use crate::experiment::shard::Shard;
 use crate::experiment::GridConfig;
 use crate::ode::MAX_THREADS;
@@ -37,7 +39,7 @@ pub struct GridArgs {
     /// quick: a reduced grid (5 seeds, 80 generations, 100-trial robustness,
     /// native backend; about a minute on 2 cores); paper: the full protocol
     /// (30 seeds, 2000 generations, 500-trial robustness, native backend).
-    #[arg(long, value_enum, default_value_t = GridPreset::Quick)]
+    #[arg(long, value_parser = choice(&GridPreset::ALL, GridPreset::name), default_value = GridPreset::Quick.name())]
     pub preset: GridPreset,
     /// Configurations, comma-separated (default: the paper's baseline,
     /// systematic, max-credit, lesion-off, erase-best, hill-climb,
@@ -93,6 +95,9 @@ pub struct GridArgs {
     /// gain from large batches). Results do not depend on it.
     #[arg(long)]
     pub lockstep: bool,
+    /// Where the networks are evaluated.
+    #[command(flatten)]
+    pub eval: EvalPathArg,
 }
 
 /// A duration such as `48h`, `90m` or `1h 30m`, above zero.
@@ -112,11 +117,6 @@ impl GridArgs {
         } else {
             Executor::RunByRun
         }
-    }
-
-    /// Opens the GPU for `--backend cuda` (see [`BackendArg::prepare`]).
-    pub fn prepare_backend(&self) -> Result<()> {
-        self.backend.map_or(Ok(()), BackendArg::prepare)
     }
 
     /// The grid these options describe.
@@ -143,14 +143,17 @@ impl GridArgs {
         Ok(spec)
     }
 
-    /// How the grid runs: threads, shard and claim timeout.
-    pub fn options(&self) -> ReplicateOptions {
-        ReplicateOptions {
+    /// How the grid runs: threads, shard, claim timeout, executor and
+    /// evaluation path (for `--backend cuda` the GPU, opened here: see
+    /// [`BackendArg::eval_path`]).
+    pub fn options(&self) -> Result<ReplicateOptions> {
+        Ok(ReplicateOptions {
             threads: self.threads as usize,
             shard: self.shard,
             claim_timeout: self.claim_timeout,
             executor: self.executor(),
-        }
+            eval_path: BackendArg::eval_path(self.backend, self.eval.eval_path.clone())?,
+        })
     }
 }
 
@@ -258,9 +261,8 @@ pub fn report_held<'a>(held: impl Iterator<Item = (String, &'a HeldRun)>) {
 /// Runs `replicate`.
 pub fn run(args: ReplicateArgs) -> Result<i32> {
     let spec = args.grid.spec()?;
-    args.grid.prepare_backend()?;
     let progress = Progress::new(args.grid.quiet);
-    let options = args.grid.options();
+    let options = args.grid.options()?;
     let summary = replicate(&args.out, &spec, &options, &progress)?;
     progress.bar.finish_and_clear();
     report_held(summary.held.iter().map(|h| (String::new(), h)));

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
+use super::choice::choice;
 use crate::experiment::report::{write_report, ReportFormat};
 
 /// Arguments of `report`.
@@ -15,7 +16,7 @@ pub struct ReportArgs {
     /// md: write report.md and print it; csv: also report.csv (one row per
     /// table cell); json: also report.json (the whole report). The figures
     /// go to DIR/figures/ in every case.
-    #[arg(long, value_enum, default_value_t = ReportFormat::Md)]
+    #[arg(long, value_parser = choice(&ReportFormat::ALL, ReportFormat::name), default_value = ReportFormat::Md.name())]
     pub format: ReportFormat,
 }
 

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 
+use super::choice::choice;
 use super::{PhysicsArgs, TRAJECTORY_HEADER};
 use crate::physics::{create_backend, for_each_state, BackendKind, BodyState, PhysicsBackend};
 use crate::psa::{limits, BodySettings, THRUSTER_COUNT};
@@ -13,7 +14,7 @@ use crate::psa::{limits, BodySettings, THRUSTER_COUNT};
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
     /// Physics backend.
-    #[arg(long, value_enum, default_value_t = BackendKind::Ode)]
+    #[arg(long, value_parser = choice(&BackendKind::ALL, BackendKind::name), default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Constant thrust of the four thrusters, each in [0, 1]: u0,u1,u2,u3.
     #[arg(

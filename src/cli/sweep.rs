@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
+use super::choice::choice;
 use super::replicate::{report_held, GridArgs, Progress};
 use crate::experiment::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
 
@@ -17,7 +18,7 @@ pub struct SweepArgs {
     pub vary: Vec<String>,
     /// combinations: every combination of the values; one-at-a-time: each
     /// setting alone (the others at the base), plus the base.
-    #[arg(long, value_enum, default_value_t = SweepMode::Combinations)]
+    #[arg(long, value_parser = choice(&SweepMode::ALL, SweepMode::name), default_value = SweepMode::Combinations.name())]
     pub mode: SweepMode,
     /// The grid each variant runs.
     #[command(flatten)]
@@ -31,9 +32,8 @@ pub struct SweepArgs {
 pub fn run(args: SweepArgs) -> Result<i32> {
     let vary = args.vary.iter().map(|v| parse_vary(v)).collect::<Result<Vec<_>>>()?;
     let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
-    args.grid.prepare_backend()?;
     let progress = Progress::new(args.grid.quiet);
-    let summary = sweep(&args.out, &spec, &args.grid.options(), &progress)?;
+    let summary = sweep(&args.out, &spec, &args.grid.options()?, &progress)?;
     progress.bar.finish_and_clear();
     report_held(summary.held.iter().map(|(variant, h)| (format!("{variant}: "), h)));
     say!(

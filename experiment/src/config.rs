@@ -1,0 +1,334 @@
+//! A run's whole configuration, the paper's presets, and TOML overrides.
+
+use std::fmt;
+use std::path::Path;
+use std::str::FromStr;
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+
+use crate::evolution::{BurstMode, Credit, EspSettings, HillClimbSettings, Sampling, TopologyMode, MAX_GENERATIONS};
+use crate::psa::PsaSettings;
+
+/// Which search algorithm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Algorithm {
+    /// Enforced Sub-Populations.
+    Esp,
+    /// The hill-climber.
+    HillClimb,
+}
+
+/// Everything that defines a run but its task and seed; written beside
+/// every result as `config.toml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    /// The search algorithm.
+    pub algorithm: Algorithm,
+    /// ESP's settings (used when `algorithm = "esp"`).
+    pub esp: EspSettings,
+    /// The hill-climber's settings (used when `algorithm = "hill_climb"`).
+    pub hill_climb: HillClimbSettings,
+    /// The control problem.
+    pub problem: PsaSettings,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        Preset::Baseline.config()
+    }
+}
+
+/// ESP's settings for the PSA, the paper's baseline (its Table 1):
+/// Høverstad's ESP with 5 sub-populations of 40 neurons at first, 10
+/// networks per neuron (400 a generation) and 2000 generations; the
+/// stagnation of 40 generations is fitted to the paper's burst totals
+/// (docs/model.md).
+pub fn paper_esp_settings() -> EspSettings {
+    EspSettings {
+        subpop_size: 40,
+        trials_per_neuron: 10,
+        initial_hidden: 5,
+        generations: 2000,
+        init_range: 6.0,
+        stagnation: 40,
+        ..EspSettings::hoverstad()
+    }
+}
+
+impl RunConfig {
+    /// The baseline: ESP, every setting at its default.
+    fn base() -> RunConfig {
+        RunConfig {
+            algorithm: Algorithm::Esp,
+            esp: paper_esp_settings(),
+            hill_climb: HillClimbSettings::default(),
+            problem: PsaSettings::default(),
+        }
+    }
+}
+
+/// The baseline configuration (Table 1), which the report compares every
+/// other configuration with.
+pub const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
+
+/// One configuration of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Preset {
+    /// ESP with burst mutation discarding all sub-populations (Table 1).
+    Baseline,
+    /// Systematic sampling (Table 4).
+    Systematic,
+    /// Max credit (Table 5).
+    MaxCredit,
+    /// No lesion tests (Table 6).
+    LesionOff,
+    /// Erase the best network on topology changes (Table 6).
+    EraseBest,
+    /// The hill-climber (Table 7).
+    HillClimb,
+    /// ESP as Gomez defined it, without the discard-all change.
+    Gomez,
+}
+
+impl Preset {
+    /// Every preset, in the paper's order.
+    pub const ALL: [Preset; 7] = [
+        Preset::Baseline,
+        Preset::Systematic,
+        Preset::MaxCredit,
+        Preset::LesionOff,
+        Preset::EraseBest,
+        Preset::HillClimb,
+        Preset::Gomez,
+    ];
+
+    /// The preset's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Baseline => "baseline",
+            Preset::Systematic => "systematic",
+            Preset::MaxCredit => "max-credit",
+            Preset::LesionOff => "lesion-off",
+            Preset::EraseBest => "erase-best",
+            Preset::HillClimb => "hill-climb",
+            Preset::Gomez => "gomez",
+        }
+    }
+
+    /// The configuration: the baseline with this preset's one change.
+    pub fn config(self) -> RunConfig {
+        self.apply(RunConfig::base())
+    }
+
+    /// `config` with this preset's one change.
+    pub fn apply(self, mut config: RunConfig) -> RunConfig {
+        match self {
+            Preset::Baseline => {}
+            Preset::Systematic => config.esp.sampling = Sampling::Systematic,
+            Preset::MaxCredit => config.esp.credit = Credit::Max,
+            Preset::LesionOff => config.esp.topology = TopologyMode::Off,
+            Preset::EraseBest => config.esp.erase_best = true,
+            Preset::HillClimb => config.algorithm = Algorithm::HillClimb,
+            Preset::Gomez => config.esp.burst = BurstMode::Gomez,
+        }
+        config
+    }
+}
+
+impl fmt::Display for Preset {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Preset {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Preset, String> {
+        by_name(s, &Preset::ALL, Preset::name, "preset")
+    }
+}
+
+/// The item of `all` called `s`, or an error listing the names.
+fn by_name<T: Copy>(s: &str, all: &[T], name: fn(T) -> &'static str, what: &str) -> Result<T, String> {
+    all.iter().copied().find(|&item| name(item) == s).ok_or_else(|| {
+        let names: Vec<&str> = all.iter().map(|&item| name(item)).collect();
+        format!("unknown {what} {s:?} (expected one of {})", names.join(", "))
+    })
+}
+
+/// Overlays `overrides` onto `base`, table by table.
+pub(super) fn merge(base: &mut toml::Table, overrides: toml::Table) {
+    for (key, value) in overrides {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, value) => {
+                base.insert(key, value);
+            }
+        }
+    }
+}
+
+impl RunConfig {
+    /// Rejects out-of-range values, naming the setting.
+    pub fn validate(&self) -> Result<()> {
+        self.esp.validate().map_err(anyhow::Error::msg)?;
+        self.hill_climb.validate().map_err(anyhow::Error::msg)?;
+        self.problem.validate().context("problem")?;
+        Ok(())
+    }
+
+    /// The baseline with the settings of a TOML document laid over it.
+    pub fn baseline_with(toml_text: &str) -> Result<RunConfig> {
+        RunConfig::base().with_overrides(toml_text)
+    }
+
+    /// This configuration with the settings of a TOML document laid over it;
+    /// unknown keys and out-of-range values are errors naming the key.
+    pub fn with_overrides(&self, toml_text: &str) -> Result<RunConfig> {
+        let overrides: toml::Table = toml::from_str(toml_text)?;
+        let mut table = toml::Table::try_from(self)?;
+        merge(&mut table, overrides);
+        let config: RunConfig = table.try_into()?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// [`RunConfig::with_overrides`] with the contents of a file.
+    pub fn with_overrides_from(&self, path: &Path) -> Result<RunConfig> {
+        let text = crate::io::read_input(path, "configuration")?;
+        self.with_overrides(&text)
+            .with_context(|| format!("configuration {}", path.display()))
+    }
+
+    /// The configuration as TOML.
+    pub fn to_toml(&self) -> Result<String> {
+        Ok(toml::to_string(self)?)
+    }
+
+    /// Overrides the generations (ESP) or cycles (hill-climber).
+    pub fn set_generations(&mut self, generations: usize) -> Result<()> {
+        if !(1..=MAX_GENERATIONS).contains(&generations) {
+            bail!("--generations must be in [1, {MAX_GENERATIONS}], got {generations}");
+        }
+        self.esp.generations = generations;
+        self.hill_climb.cycles = generations;
+        Ok(())
+    }
+
+    /// Generations (or cycles) of the configured algorithm.
+    pub fn generations(&self) -> usize {
+        match self.algorithm {
+            Algorithm::Esp => self.esp.generations,
+            Algorithm::HillClimb => self.hill_climb.cycles,
+        }
+    }
+}
+
+/// One configuration of the replication grid: a preset of the paper's
+/// Tables 1 and 4-7 (and Gomez's ESP), or one of Table 3's two, evolved
+/// under input noise or random initialisation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum GridConfig {
+    /// A preset.
+    Preset(Preset),
+    /// Baseline ESP evolved under input noise sd 0.05, each network evaluated 3 times (Table 3).
+    InputNoise,
+    /// Baseline ESP evolved with random initial conditions, each network evaluated 3 times (Table 3; tasks 1 and 3).
+    RandomInit,
+}
+
+/// Input noise of Table 3's evolution and of the robustness tests. `[paper]` 0.05
+pub const PAPER_NOISE_SD: f64 = 0.05;
+/// Trials per evaluation under noise or random initialisation. `[paper]` 3
+pub const PAPER_NOISY_TRIALS: usize = 3;
+
+impl GridConfig {
+    /// Every configuration of the grid, in report order.
+    pub const ALL: [GridConfig; 9] = [
+        GridConfig::Preset(Preset::Baseline),
+        GridConfig::Preset(Preset::Systematic),
+        GridConfig::Preset(Preset::MaxCredit),
+        GridConfig::Preset(Preset::LesionOff),
+        GridConfig::Preset(Preset::EraseBest),
+        GridConfig::Preset(Preset::HillClimb),
+        GridConfig::Preset(Preset::Gomez),
+        GridConfig::InputNoise,
+        GridConfig::RandomInit,
+    ];
+
+    /// Whether the paper ran it: all but `gomez`. The paper's configurations
+    /// are a grid's default; `gomez` joins when named.
+    pub fn in_paper(self) -> bool {
+        self != GridConfig::Preset(Preset::Gomez)
+    }
+
+    /// The configuration's name (folder and command-line name).
+    pub fn name(self) -> &'static str {
+        match self {
+            GridConfig::Preset(p) => p.name(),
+            GridConfig::InputNoise => "input-noise",
+            GridConfig::RandomInit => "random-init",
+        }
+    }
+
+    /// The run configuration.
+    pub fn config(self) -> RunConfig {
+        self.apply(RunConfig::base())
+    }
+
+    /// `base` (a configuration of the baseline, such as one with a file's
+    /// settings laid over it) with this configuration's change.
+    pub fn apply(self, base: RunConfig) -> RunConfig {
+        match self {
+            GridConfig::Preset(p) => p.apply(base),
+            GridConfig::InputNoise => {
+                let mut c = base;
+                c.problem.noise.input_sd = PAPER_NOISE_SD;
+                c.problem.trials = PAPER_NOISY_TRIALS;
+                c
+            }
+            GridConfig::RandomInit => {
+                let mut c = base;
+                c.problem.random_init = true;
+                c.problem.trials = PAPER_NOISY_TRIALS;
+                c
+            }
+        }
+    }
+
+    /// Whether the configuration applies to `task` (random initialisation: tasks 1 and 3 only).
+    pub fn applies_to(self, task: crate::psa::Task) -> bool {
+        self != GridConfig::RandomInit || task.has_random_init()
+    }
+}
+
+impl fmt::Display for GridConfig {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for GridConfig {
+    type Err = String;
+    fn from_str(s: &str) -> Result<GridConfig, String> {
+        by_name(s, &GridConfig::ALL, GridConfig::name, "configuration")
+    }
+}
+
+impl TryFrom<String> for GridConfig {
+    type Error = String;
+    fn try_from(s: String) -> Result<GridConfig, String> {
+        s.parse()
+    }
+}
+
+impl From<GridConfig> for String {
+    fn from(c: GridConfig) -> String {
+        c.name().to_string()
+    }
+}

@@ -1,0 +1,61 @@
+//! psa-experiment: experiments on the simulated PSA (`psa-sim`): run
+//! configurations and presets, single evolution runs written to disk, the
+//! replication grid and its executors, robustness tests, the results
+//! model, statistics, the report beside the paper's tables, and plots.
+//!
+//! It sits between the simulator and the command line: it may not depend
+//! on the command line (`clap`) or the `psa-esp` binary, and the simulator
+//! may not depend on it. `.ci/run` checks its `cargo tree`.
+
+pub mod claim;
+pub mod columns;
+mod config;
+pub mod grid;
+pub mod grid_run;
+pub mod lockstep;
+pub mod ode_check;
+pub mod plots;
+pub mod replicate;
+pub mod report;
+pub mod rescore;
+pub mod results;
+pub mod robustness;
+mod run;
+pub mod runs_table;
+pub mod shard;
+pub mod stats;
+pub mod sweep;
+
+pub use config::{
+    paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, BASELINE, PAPER_NOISE_SD, PAPER_NOISY_TRIALS,
+};
+pub use report::{write_report, ReportFormat, ReportOutcome};
+pub use results::EvolveOutcome;
+pub use run::{records_csv, run_evolution, RunFiles, RunStart};
+
+// The lower layers under the paths this crate's modules name them by
+// (`crate::psa`, `crate::evolution`, ...).
+use esp_neuroevolution as evolution;
+use esp_neuroevolution::{network, rng};
+use psa_sim::{evaluator, io, ode, physics, provenance, psa};
+
+/// The build's identity, recorded in every result file: this crate's
+/// version, the git commit (stamped by this crate's `build.rs`, with
+/// `-dirty` for uncommitted changes) and the libode version.
+pub fn build_info() -> psa_sim::provenance::BuildInfo {
+    psa_sim::provenance::BuildInfo {
+        tool_version: env!("CARGO_PKG_VERSION").into(),
+        git_commit: env!("PSA_ESP_GIT_COMMIT").into(),
+        libode_version: ode::libode_version().into(),
+    }
+}
+
+/// What `psa-esp --version` prints after the name: the version, the commit
+/// and the libode version of [`build_info`].
+pub fn version() -> String {
+    let build = build_info();
+    format!(
+        "{} (commit {}, libode {})",
+        build.tool_version, build.git_commit, build.libode_version
+    )
+}

@@ -1,0 +1,223 @@
+//! The lockstep grid executor: every run of a grid (or of what is left of
+//! it) advanced together, one round per generation, each round's networks
+//! of all runs evaluated in one batch (the search crate's
+//! [`lockstep_with`]).
+//! Each run is the run it is on its own, bit for bit: its files are
+//! byte-identical to those of the run-by-run executor (run.json's times
+//! aside). Every `CHECKPOINT_ROUNDS` rounds each unfinished run saves its
+//! whole state to [`CHECKPOINT`] in its folder; a grid killed and started
+//! again resumes each run from there, to the same files.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use anyhow::{Context, Result};
+use rayon::prelude::*;
+
+use super::grid::{run_dir, GridSpec, RunKey};
+use super::grid_run::{run_seed, test_and_mark, FinishedRun};
+use super::{Algorithm, GridConfig, RunConfig, RunStart};
+use crate::evaluator::{EvalPath, PsaEvaluator};
+use crate::evolution::lockstep::lockstep_with;
+use crate::evolution::{AnyRun, AskTell, Control, Esp, HillClimb};
+use crate::psa::Task;
+
+/// A lockstep run's saved state, in its folder while it is unfinished.
+pub const CHECKPOINT: &str = "checkpoint.json";
+
+/// Rounds between two checkpoints of the runs (a round is a generation, or
+/// an ESP lesion test).
+const CHECKPOINT_ROUNDS: usize = 20;
+
+/// How `replicate` and `sweep` advance the runs of a grid. Results do not
+/// depend on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Executor {
+    /// Each run from start to end on its own, the runs spread over the
+    /// threads (a finished run is written at once).
+    #[default]
+    RunByRun,
+    /// All runs together, a generation per round, every round's networks
+    /// evaluated as one batch; the runs are written once all have ended
+    /// (a grid's runs, of equal length, end at the same round), and saved
+    /// every few rounds, so a grid killed before then resumes each run
+    /// from its last checkpoint.
+    Lockstep,
+}
+
+/// A run started on disk, ready to be driven.
+struct Started {
+    key: RunKey,
+    config: RunConfig,
+    seed: u64,
+    start: RunStart,
+    /// Its evaluator's index.
+    evaluator: usize,
+}
+
+/// Runs `todo` of `spec` in `dir` in lockstep on the current rayon pool,
+/// their networks evaluated on `path`, handing each run's outcome to
+/// `finished` as [`crate::grid_run::run_one`] would give it.
+pub(super) fn replicate_lockstep(
+    dir: &Path,
+    spec: &GridSpec,
+    todo: &[RunKey],
+    path: &EvalPath,
+    finished: &(dyn Fn(Result<FinishedRun>) + Sync),
+) {
+    let mut evaluators: Vec<((GridConfig, Task), PsaEvaluator)> = Vec::new();
+    let mut started = Vec::new();
+    let mut runs: Vec<AnyRun> = Vec::new();
+    for key in todo {
+        let folder = run_dir(dir, key);
+        match begin(spec, key, &folder, path, &mut evaluators) {
+            Ok((run, search)) => {
+                started.push(run);
+                runs.push(search);
+            }
+            Err(e) => finished(Err(e.context(format!("run {}", folder.display())))),
+        }
+    }
+    let which: Vec<&PsaEvaluator> = started.iter().map(|s| &evaluators[s.evaluator].1).collect();
+    let folders: Vec<PathBuf> = started.iter().map(|s| run_dir(dir, &s.key).join(CHECKPOINT)).collect();
+    let live: Vec<Mutex<&mut RunStart>> = started.iter_mut().map(|s| Mutex::new(&mut s.start)).collect();
+    let on_record = |run: usize, record: &_| {
+        live[run]
+            .lock()
+            .expect("no panics while holding the lock")
+            .record(record);
+        Control::Continue
+    };
+    let errors = lockstep_with(&mut runs, &which, on_record, |round, runs| {
+        if round % CHECKPOINT_ROUNDS == 0 {
+            save_checkpoints(runs, &folders);
+        }
+    });
+    drop(live);
+    started
+        .into_par_iter()
+        .zip(runs)
+        .zip(errors)
+        .with_max_len(1)
+        .for_each(|((run, search), error)| {
+            let folder = run_dir(dir, &run.key);
+            let outcome = match error {
+                Some(e) => Err(e.into()),
+                None => search.result().map_err(anyhow::Error::from).and_then(|result| {
+                    let outcome =
+                        run.start
+                            .finish(&run.config, run.key.config.name(), run.key.task, run.seed, &result)?;
+                    remove_checkpoint(&folder)?;
+                    Ok(outcome)
+                }),
+            };
+            finished(
+                outcome
+                    .with_context(|| format!("run {}", folder.display()))
+                    .and_then(|outcome| test_and_mark(dir, spec, &run.key, outcome)),
+            );
+        });
+}
+
+/// Saves every unfinished run of `runs` to its checkpoint file (of
+/// `files`), in parallel; a run that cannot be saved goes on unsaved.
+fn save_checkpoints(runs: &[AnyRun], files: &[PathBuf]) {
+    runs.par_iter().zip(files).with_max_len(1).for_each(|(run, file)| {
+        if run.ending().is_none() {
+            let saved = serde_json::to_vec(run).map_err(anyhow::Error::from);
+            if let Err(e) = saved.and_then(|json| crate::io::write_atomic(file, &json)) {
+                log::warn!("cannot save {}: {e:#}", file.display());
+            }
+        }
+    });
+}
+
+/// Removes a finished run's checkpoint, if any.
+fn remove_checkpoint(folder: &Path) -> Result<()> {
+    match std::fs::remove_file(folder.join(CHECKPOINT)) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).with_context(|| format!("cannot remove {}", folder.join(CHECKPOINT).display()))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The run that `folder`'s checkpoint saved, when there is one of the
+/// same search as `fresh` (else `fresh`, a checkpoint that cannot be read
+/// or is of another search being ignored).
+fn resume(folder: &Path, fresh: AnyRun) -> AnyRun {
+    let file = folder.join(CHECKPOINT);
+    let Ok(json) = std::fs::read(&file) else {
+        return fresh;
+    };
+    match serde_json::from_slice::<AnyRun>(&json) {
+        Ok(saved) if saved.same_search(&fresh) => {
+            log::info!(
+                "{}: resumed after generation {}",
+                folder.display(),
+                saved.records().len()
+            );
+            saved
+        }
+        Ok(_) => {
+            log::warn!("{}: of another search, ignored", file.display());
+            fresh
+        }
+        Err(e) => {
+            log::warn!("{}: cannot be read ({e}), ignored", file.display());
+            fresh
+        }
+    }
+}
+
+/// Starts run `key` in `folder` (its `config.toml`, as the run-by-run
+/// executor writes it) and its search, resumed from its checkpoint if it
+/// has one; finds or makes its evaluator.
+fn begin(
+    spec: &GridSpec,
+    key: &RunKey,
+    folder: &Path,
+    path: &EvalPath,
+    evaluators: &mut Vec<((GridConfig, Task), PsaEvaluator)>,
+) -> Result<(Started, AnyRun)> {
+    let config = spec.run_config(key.config)?;
+    let seed = run_seed(key);
+    let mut start = RunStart::new(&config, folder)?;
+    let cell = (key.config, key.task);
+    let evaluator = match evaluators.iter().position(|(c, _)| *c == cell) {
+        Some(index) => index,
+        None => {
+            evaluators.push((cell, PsaEvaluator::new(config.problem.clone(), key.task, path)?));
+            evaluators.len() - 1
+        }
+    };
+    let (inputs, outputs) = {
+        use crate::evolution::Evaluator;
+        let e = &evaluators[evaluator].1;
+        (e.inputs(), e.outputs())
+    };
+    let fresh: AnyRun = match config.algorithm {
+        Algorithm::Esp => Esp::new(config.esp.clone(), seed)
+            .map_err(anyhow::Error::msg)?
+            .start(inputs, outputs)?
+            .into(),
+        Algorithm::HillClimb => HillClimb::new(config.hill_climb.clone(), seed)
+            .map_err(anyhow::Error::msg)?
+            .start(inputs, outputs)?
+            .into(),
+    };
+    let search = resume(folder, fresh);
+    for record in search.records() {
+        start.record(record);
+    }
+    Ok((
+        Started {
+            key: *key,
+            config,
+            seed,
+            start,
+            evaluator,
+        },
+        search,
+    ))
+}

@@ -1,0 +1,259 @@
+//! Running the replication grid: every (configuration, task, seed) as an
+//! independent run in its own folder, then its robustness tests; finished
+//! runs are skipped, so a killed grid resumes where it stopped. A process
+//! may run one shard of the grid ([`Shard`]), and several processes may
+//! work on one folder: each claims a run before running it ([`claim`]).
+
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
+
+use super::claim::{claim, Attempt, Claim, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
+use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
+use super::grid_run::{run_one, FinishedRun};
+use super::lockstep::{replicate_lockstep, Executor};
+use super::shard::Shard;
+use crate::evaluator::EvalPath;
+
+/// Something to tell the user while the grid runs.
+pub trait GridProgress: Sync {
+    /// The grid (or this shard of it) has `total` runs, `done` of them
+    /// finished before this call.
+    fn start(&self, total: usize, done: usize);
+    /// A run finished.
+    fn finished(&self, run: &FinishedRun);
+}
+
+/// How [`replicate`] runs: threads, shard, claims, executor and evaluation
+/// path.
+#[derive(Debug, Clone)]
+pub struct ReplicateOptions {
+    /// Worker threads (0 = one per core). Results do not depend on it.
+    pub threads: usize,
+    /// Which runs of the grid's run order this process does.
+    pub shard: Shard,
+    /// How old another process's claim on a run may grow before this one
+    /// takes it over.
+    pub claim_timeout: Duration,
+    /// How the runs are advanced: run by run, or all in lockstep. Results
+    /// do not depend on it.
+    pub executor: Executor,
+    /// Where the runs' networks are evaluated. Results do not depend on it.
+    pub eval_path: EvalPath,
+}
+
+impl Default for ReplicateOptions {
+    fn default() -> Self {
+        ReplicateOptions {
+            threads: 0,
+            shard: Shard::ALL,
+            claim_timeout: DEFAULT_CLAIM_TIMEOUT,
+            executor: Executor::RunByRun,
+            eval_path: EvalPath::Fastest,
+        }
+    }
+}
+
+/// A run another live process holds (and this one left to it).
+#[derive(Debug, Clone)]
+pub struct HeldRun {
+    /// The run.
+    pub key: RunKey,
+    /// Who holds it.
+    pub claim: ClaimRecord,
+}
+
+/// The summary of [`replicate`].
+#[derive(Debug, Clone)]
+pub struct ReplicateSummary {
+    /// Runs in the grid (or in this shard of it).
+    pub total: usize,
+    /// Runs that were already finished (by any process).
+    pub skipped: usize,
+    /// Runs done now by this process.
+    pub ran: usize,
+    /// Runs other processes were running, left to them.
+    pub held: Vec<HeldRun>,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// Checks `dir` against `spec`: a new directory gets `grid.json` (of
+/// processes starting together, exactly one writes it); an existing grid
+/// must have the same definition. Returns the runs of `shard` still to do,
+/// and how many of its runs are finished.
+pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard) -> Result<(Vec<RunKey>, usize)> {
+    spec.validate()?;
+    let grid_file = super::grid::grid_file(dir);
+    // `runs/` first: a grid's run folders appear only after its grid.json.
+    if dir.join("runs").exists() && !grid_file.exists() {
+        bail!(
+            "{} has run folders but no grid.json: not a grid this tool wrote; use another --out",
+            dir.display()
+        );
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut json = serde_json::to_string_pretty(spec)?;
+    json.push('\n');
+    if !grid_file.exists() && crate::io::create_new_atomic(&grid_file, json.as_bytes())? {
+        // This process wrote grid.json.
+    } else {
+        let existing = GridSpec::load(dir)?;
+        if existing != *spec {
+            bail!(
+                "{} holds a grid with another definition ({}); resume it with the same options or use another --out",
+                dir.display(),
+                describe(&existing)
+            );
+        }
+    }
+    let mut todo = Vec::new();
+    let mut problems = Vec::new();
+    let runs = shard.select(&spec.runs());
+    for key in &runs {
+        match run_status(dir, spec, key) {
+            Ok(RunStatus::Finished) => {}
+            Ok(RunStatus::Missing | RunStatus::Unfinished) => todo.push(*key),
+            Err(e) => problems.push(format!("{e:#}")),
+        }
+    }
+    if !problems.is_empty() {
+        bail!(
+            "{} run folder(s) cannot be resumed safely and were left untouched:\n  {}",
+            problems.len(),
+            problems.join("\n  ")
+        );
+    }
+    let done = runs.len() - todo.len();
+    Ok((todo, done))
+}
+
+/// A one-line description of a grid.
+pub fn describe(spec: &GridSpec) -> String {
+    let configs: Vec<&str> = spec.configs.iter().map(|c| c.name()).collect();
+    let tasks: Vec<String> = spec.tasks.iter().map(|t| t.to_string()).collect();
+    format!(
+        "configs {}, tasks {}, seeds {}, {} generations, backend {}{}, {} robustness trials",
+        configs.join(","),
+        tasks.join(","),
+        spec.seeds,
+        spec.generations,
+        spec.backend,
+        if spec.ode_check {
+            " (every champion checked on ode)"
+        } else {
+            ""
+        },
+        spec.robustness_trials
+    )
+}
+
+/// What claiming a run found.
+enum Claimed {
+    /// The run is this process's (until the claim is dropped), and unfinished.
+    Mine(Claim),
+    /// Another process finished it first.
+    AlreadyFinished,
+    /// Another process is running it.
+    Held(ClaimRecord),
+}
+
+/// Claims the run `key` unless another live process holds it; a run
+/// another process finished meanwhile is left alone.
+fn claim_unfinished(dir: &Path, spec: &GridSpec, key: &RunKey, timeout: Duration) -> Result<Claimed> {
+    let claim = match claim(&run_dir(dir, key), timeout)? {
+        Attempt::Held(record) => return Ok(Claimed::Held(record)),
+        Attempt::Claimed(claim) => claim,
+    };
+    if run_status(dir, spec, key)? == RunStatus::Finished {
+        return Ok(Claimed::AlreadyFinished);
+    }
+    Ok(Claimed::Mine(claim))
+}
+
+/// Runs every unfinished run of `options.shard` of `spec` in `dir`, on
+/// `options.threads` threads, claiming each run first so that other
+/// processes on the same folder never run it too. Results do not depend on
+/// threads, shards, other processes or interruptions.
+pub fn replicate(
+    dir: &Path,
+    spec: &GridSpec,
+    options: &ReplicateOptions,
+    progress: &dyn GridProgress,
+) -> Result<ReplicateSummary> {
+    let clock = Instant::now();
+    let (todo, skipped) = prepare(dir, spec, options.shard)?;
+    progress.start(todo.len() + skipped, skipped);
+    let pool = crate::ode::thread_pool(options.threads)?;
+    let failures = Mutex::new(Vec::new());
+    let held = Mutex::new(Vec::new());
+    let ran = AtomicU64::new(0);
+    let finished_elsewhere = AtomicU64::new(0);
+    let lock = "no panics while holding the lock";
+    let finished = |result: Result<FinishedRun>| match result {
+        Ok(run) => {
+            ran.fetch_add(1, Ordering::Relaxed);
+            progress.finished(&run);
+        }
+        Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
+    };
+    // The claim on `key` if the run is this process's; the other outcomes
+    // are counted here.
+    let take = |key: &RunKey| match claim_unfinished(dir, spec, key, options.claim_timeout) {
+        Ok(Claimed::Mine(claim)) => Some(claim),
+        Ok(Claimed::AlreadyFinished) => {
+            finished_elsewhere.fetch_add(1, Ordering::Relaxed);
+            None
+        }
+        Ok(Claimed::Held(claim)) => {
+            held.lock().expect(lock).push(HeldRun { key: *key, claim });
+            None
+        }
+        Err(e) => {
+            finished(Err(e));
+            None
+        }
+    };
+    pool.install(|| match options.executor {
+        Executor::RunByRun => todo.par_iter().with_max_len(1).for_each(|key| {
+            if let Some(claim) = take(key) {
+                // The claim goes once the run's files are complete.
+                let run = run_one(dir, spec, key, &options.eval_path);
+                drop(claim);
+                finished(run);
+            }
+        }),
+        Executor::Lockstep => {
+            // Every run is claimed before the first round and released once
+            // all are written.
+            let mut claims = Vec::new();
+            let mut mine = Vec::new();
+            for key in &todo {
+                if let Some(claim) = take(key) {
+                    claims.push(claim);
+                    mine.push(*key);
+                }
+            }
+            replicate_lockstep(dir, spec, &mine, &options.eval_path, &finished);
+            drop(claims);
+        }
+    });
+    let failures = failures.into_inner().expect(lock);
+    if !failures.is_empty() {
+        bail!("{} run(s) failed:\n  {}", failures.len(), failures.join("\n  "));
+    }
+    let mut held = held.into_inner().expect(lock);
+    let order = spec.runs();
+    held.sort_by_key(|h| order.iter().position(|k| *k == h.key));
+    Ok(ReplicateSummary {
+        total: todo.len() + skipped,
+        skipped: skipped + finished_elsewhere.load(Ordering::Relaxed) as usize,
+        ran: ran.load(Ordering::Relaxed) as usize,
+        held,
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}

@@ -1,0 +1,340 @@
+//! The report of a sweep (`psa-esp report` on a folder with `sweep.json`):
+//! per variant the Table 1 levels, bursts per run, the robustness collapse
+//! ratios, each finding's verdict and the distance to the paper; then the
+//! sensitivity map: for each varied setting, the findings whose verdict
+//! flips across its values while every other setting stays the same.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use serde::Serialize;
+
+use super::distance::Distance;
+use super::findings::Verdict;
+use super::paper::PAPER_TASKS;
+use super::render::num;
+use super::tables::Report;
+use super::{GridResults, Metric};
+use crate::grid::grid_file;
+use crate::runs_table::{sweep_runs_csv, VariantRuns, RUNS_CSV};
+use crate::sweep::{variant_dir, SweepSpec};
+use crate::BASELINE;
+use crate::{GridConfig, Preset};
+
+/// One variant's summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct VariantSummary {
+    /// Its folder name.
+    pub name: String,
+    /// Its varied settings (key, TOML value).
+    pub settings: Vec<(String, String)>,
+    /// Runs counted / runs of its grid.
+    pub runs: (usize, usize),
+    /// Baseline champion mean per task 1-3 (Table 1; NaN without runs).
+    pub table1: [f64; 3],
+    /// Mean burst mutations per run: baseline, max credit.
+    pub bursts_per_run: [f64; 2],
+    /// Baseline champions' mean under input noise / their clean mean.
+    pub noise_ratio: f64,
+    /// Baseline champions' mean from random starts / their clean mean (tasks 1 and 3).
+    pub random_init_ratio: f64,
+    /// Each finding's claim and verdict.
+    pub findings: Vec<(String, Verdict)>,
+    /// The distance to the paper.
+    pub distance: Distance,
+}
+
+/// A varied setting and the findings whose verdict depends on it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Sensitivity {
+    /// The setting.
+    pub key: String,
+    /// Its values.
+    pub values: Vec<String>,
+    /// Findings whose verdict differs between two variants that differ in this setting only.
+    pub flips: Vec<String>,
+}
+
+/// The whole sweep report (`sweep.json`'s companion `sweep-report.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepReport {
+    /// The sweep.
+    pub sweep: SweepSpec,
+    /// Per variant.
+    pub variants: Vec<VariantSummary>,
+    /// Per varied setting.
+    pub sensitivity: Vec<Sensitivity>,
+    /// Findings reproduced in every variant where they could be judged.
+    pub hold_everywhere: Vec<String>,
+    /// Findings not reproduced in any variant where they could be judged.
+    pub fail_everywhere: Vec<String>,
+    /// Findings reproduced in some variants and not in others.
+    pub depend: Vec<String>,
+}
+
+fn mean(values: &[f64]) -> f64 {
+    values.iter().sum::<f64>() / values.len() as f64
+}
+
+impl VariantSummary {
+    fn of(name: String, settings: Vec<(String, String)>, results: &GridResults) -> VariantSummary {
+        let report = Report::from_results(results);
+        let tasks = &results.spec.tasks;
+        let per_run = |config| mean(&results.values(config, tasks, Metric::Bursts));
+        let ratio = |metric: Metric| {
+            let tested: Vec<&super::RunData> = results
+                .runs_of(BASELINE, tasks)
+                .filter(|r| r.value(metric).is_some())
+                .collect();
+            let robust: Vec<f64> = tested.iter().filter_map(|r| r.value(metric)).collect();
+            let clean: Vec<f64> = tested.iter().map(|r| r.robustness.clean).collect();
+            mean(&robust) / mean(&clean)
+        };
+        VariantSummary {
+            name,
+            settings,
+            runs: (results.runs.len(), results.spec.runs().len()),
+            table1: PAPER_TASKS.map(|t| mean(&results.values(BASELINE, &[t], Metric::Champion))),
+            bursts_per_run: [per_run(BASELINE), per_run(GridConfig::Preset(Preset::MaxCredit))],
+            noise_ratio: ratio(Metric::InputNoise),
+            random_init_ratio: ratio(Metric::RandomInit),
+            findings: report.findings.iter().map(|f| (f.claim.clone(), f.verdict)).collect(),
+            distance: report.distance,
+        }
+    }
+}
+
+impl SweepReport {
+    /// Reads every variant of the sweep in `dir`.
+    pub fn load(dir: &Path) -> Result<SweepReport> {
+        Ok(Self::load_with_results(dir)?.0)
+    }
+
+    /// [`SweepReport::load`], keeping each variant's results (in variant order).
+    fn load_with_results(dir: &Path) -> Result<(SweepReport, Vec<GridResults>)> {
+        let sweep = SweepSpec::load(dir)?;
+        let mut variants = Vec::new();
+        let mut grids = Vec::new();
+        for variant in sweep.variants() {
+            let folder = variant_dir(dir, &variant);
+            // A variant the sweep has not reached yet counts as a grid without runs.
+            let results = if grid_file(&folder).exists() {
+                GridResults::load(&folder)?
+            } else {
+                GridResults {
+                    dir: folder,
+                    spec: sweep.variant_grid(&variant)?,
+                    runs: Vec::new(),
+                    incomplete: Vec::new(),
+                    problems: Vec::new(),
+                }
+            };
+            variants.push(VariantSummary::of(variant.name, variant.settings, &results));
+            grids.push(results);
+        }
+        let sensitivity = sweep
+            .vary
+            .iter()
+            .map(|v| Sensitivity {
+                key: v.key.clone(),
+                values: v.values.clone(),
+                flips: flips(&variants, &v.key),
+            })
+            .collect();
+        let mut by_claim: BTreeMap<&str, Vec<Verdict>> = BTreeMap::new();
+        let mut order = Vec::new();
+        for (claim, verdict) in variants.iter().flat_map(|v| &v.findings) {
+            if !by_claim.contains_key(claim.as_str()) {
+                order.push(claim.clone());
+            }
+            by_claim.entry(claim).or_default().push(*verdict);
+        }
+        let judged = |claim: &String| -> Vec<Verdict> {
+            by_claim[claim.as_str()]
+                .iter()
+                .copied()
+                .filter(|v| *v != Verdict::NotTestable)
+                .collect()
+        };
+        let select = |keep: &dyn Fn(&[Verdict]) -> bool| -> Vec<String> {
+            order.iter().filter(|c| keep(&judged(c))).cloned().collect()
+        };
+        let report = SweepReport {
+            hold_everywhere: select(&|v| !v.is_empty() && v.iter().all(|x| *x == Verdict::Reproduced)),
+            fail_everywhere: select(&|v| !v.is_empty() && v.iter().all(|x| *x == Verdict::NotReproduced)),
+            depend: select(&|v| v.contains(&Verdict::Reproduced) && v.contains(&Verdict::NotReproduced)),
+            sweep,
+            variants,
+            sensitivity,
+        };
+        Ok((report, grids))
+    }
+
+    /// The report as Markdown.
+    pub fn markdown(&self) -> String {
+        let mut md = String::from("# Sweep report\n\n");
+        let varied: Vec<String> = self
+            .sweep
+            .vary
+            .iter()
+            .map(|v| format!("`{}` = {}", v.key, v.values.join(", ")))
+            .collect();
+        let _ = writeln!(
+            md,
+            "Varied ({:?}): {}. Every variant runs the same grid ({} seeds, {} generations, backend {}); \
+             `psa-esp report variants/<variant>` gives a variant's full report.\n",
+            self.sweep.mode,
+            varied.join("; "),
+            self.sweep.grid.seeds,
+            self.sweep.grid.generations,
+            self.sweep.grid.backend
+        );
+        md.push_str("## Variants\n\n");
+        md.push_str(
+            "Table 1: baseline champions (%), paper 42.4 / 44.0 / 11.9. Bursts per run: baseline and max credit, \
+             paper 27.2 and 20.8. Noise and random-init ratios: the baseline champions' robust mean over their clean mean \
+             (paper 0.11 and 0.22). D: the distance to the paper (smaller is closer; docs/model.md).\n\n",
+        );
+        md.push_str("| variant | runs | T1 task 1 | T1 task 2 | T1 task 3 | bursts base | bursts max | noise ratio | random-init ratio | D |\n");
+        md.push_str("|---|---|---|---|---|---|---|---|---|---|\n");
+        for v in &self.variants {
+            let _ = writeln!(
+                md,
+                "| {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {:.1} |",
+                v.name,
+                v.runs.0,
+                v.runs.1,
+                num(v.table1[0]),
+                num(v.table1[1]),
+                num(v.table1[2]),
+                num(v.bursts_per_run[0]),
+                num(v.bursts_per_run[1]),
+                ratio(v.noise_ratio),
+                ratio(v.random_init_ratio),
+                v.distance.total
+            );
+        }
+        if let Some(best) = self
+            .variants
+            .iter()
+            .min_by(|a, b| a.distance.total.total_cmp(&b.distance.total))
+        {
+            let _ = writeln!(
+                md,
+                "\nClosest to the paper: {} (D = {:.1}).",
+                best.name, best.distance.total
+            );
+        }
+        md.push_str("\n## Findings per variant\n\n");
+        let claims: Vec<&String> = self
+            .variants
+            .first()
+            .map(|v| v.findings.iter().map(|(c, _)| c).collect())
+            .unwrap_or_default();
+        md.push_str("| finding |");
+        for v in &self.variants {
+            let _ = write!(md, " {} |", v.name);
+        }
+        md.push_str("\n|---|");
+        md.push_str(&"---|".repeat(self.variants.len()));
+        md.push('\n');
+        for claim in claims {
+            let _ = write!(md, "| {claim} |");
+            for v in &self.variants {
+                let verdict = v.findings.iter().find(|(c, _)| c == claim).map(|(_, x)| *x);
+                let mark = match verdict {
+                    Some(Verdict::Reproduced) => "yes",
+                    Some(Verdict::NotReproduced) => "no",
+                    _ => "–",
+                };
+                let _ = write!(md, " {mark} |");
+            }
+            md.push('\n');
+        }
+        md.push_str("\n## Sensitivity\n\n");
+        md.push_str("A finding depends on a setting when its verdict differs between two variants that differ in that setting only.\n\n");
+        md.push_str("| setting | values | findings that flip |\n|---|---|---|\n");
+        for s in &self.sensitivity {
+            let flips = if s.flips.is_empty() {
+                "none".to_string()
+            } else {
+                s.flips.join("; ")
+            };
+            let _ = writeln!(md, "| `{}` | {} | {} |", s.key, s.values.join(", "), flips);
+        }
+        let list = |md: &mut String, title: &str, claims: &[String]| {
+            let _ = writeln!(md, "\n{title}\n");
+            if claims.is_empty() {
+                md.push_str("- none\n");
+            }
+            for c in claims {
+                let _ = writeln!(md, "- {c}");
+            }
+        };
+        list(&mut md, "Findings that hold in every variant:", &self.hold_everywhere);
+        list(&mut md, "Findings that depend on the settings:", &self.depend);
+        list(&mut md, "Findings that fail in every variant:", &self.fail_everywhere);
+        md
+    }
+}
+
+fn ratio(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.2}")
+    } else {
+        "–".into()
+    }
+}
+
+/// The findings whose verdict differs between two variants that set every
+/// setting but `key` alike (a setting a variant leaves out is at its base).
+fn flips(variants: &[VariantSummary], key: &str) -> Vec<String> {
+    let mut groups: BTreeMap<Vec<(String, String)>, Vec<&VariantSummary>> = BTreeMap::new();
+    for v in variants {
+        let others: Vec<(String, String)> = v.settings.iter().filter(|(k, _)| k != key).cloned().collect();
+        groups.entry(others).or_default().push(v);
+    }
+    let mut flipped: Vec<String> = Vec::new();
+    for group in groups.values().filter(|g| g.len() > 1) {
+        for (i, (claim, _)) in group[0].findings.iter().enumerate() {
+            let verdicts: Vec<Verdict> = group
+                .iter()
+                .filter_map(|v| v.findings.get(i).map(|(_, x)| *x))
+                .filter(|x| *x != Verdict::NotTestable)
+                .collect();
+            let differs = verdicts.windows(2).any(|w| w[0] != w[1]);
+            if differs && !flipped.contains(claim) {
+                flipped.push(claim.clone());
+            }
+        }
+    }
+    flipped
+}
+
+/// Reads the sweep in `dir` and writes `sweep-report.md`,
+/// `sweep-report.json` and `runs.csv` (every variant's finished runs, a
+/// column per varied setting) into it; returns the report and the files.
+pub fn write_sweep_report(dir: &Path) -> Result<(SweepReport, String, Vec<PathBuf>)> {
+    let (report, grids) = SweepReport::load_with_results(dir)?;
+    let markdown = report.markdown();
+    let md_path = dir.join("sweep-report.md");
+    crate::io::write_atomic(&md_path, markdown.as_bytes())?;
+    let json_path = dir.join("sweep-report.json");
+    crate::io::write_json(&json_path, &report)?;
+    let keys: Vec<String> = report.sweep.vary.iter().map(|v| v.key.clone()).collect();
+    let variants: Vec<VariantRuns> = report
+        .variants
+        .iter()
+        .zip(&grids)
+        .map(|(variant, grid)| VariantRuns {
+            name: &variant.name,
+            dir: &grid.dir,
+            runs: &grid.runs,
+        })
+        .collect();
+    let runs_path = dir.join(RUNS_CSV);
+    crate::io::write_atomic(&runs_path, sweep_runs_csv(&keys, &variants)?.as_bytes())?;
+    Ok((report, markdown, vec![md_path, json_path, runs_path]))
+}

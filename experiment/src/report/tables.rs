@@ -1,0 +1,412 @@
+//! The report's content: the grid, what is missing, the tables beside the
+//! paper's, the burst counts and the findings.
+
+use super::distance::Distance;
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::findings::{findings, Finding};
+use super::paper::{paper_bursts, paper_cell, PaperCell};
+use super::{GridResults, Metric, Problem};
+use crate::grid::{GridPreset, GridSpec, RunStatus};
+use crate::provenance::BuildInfo;
+use crate::psa::Task;
+use crate::stats::{mean_sd, welch};
+use crate::BASELINE;
+use crate::{GridConfig, Preset};
+
+/// One row of a table: a configuration's champions on a task (or All).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Row {
+    /// The configuration whose champions these are.
+    pub config: GridConfig,
+    /// What is measured.
+    pub metric: Metric,
+    /// "1", "2", "3" or "All" (the grid's tasks pooled).
+    pub task: String,
+    /// Champions counted here.
+    pub n: usize,
+    /// Mean here (% of the theoretical maximum; NaN when n = 0).
+    pub mean: f64,
+    /// Sample sd here (NaN when n < 2).
+    pub sd: f64,
+    /// Welch p here against the table's reference (NaN when n < 2 on either side).
+    pub p: Option<f64>,
+    /// The paper's cell, if it has one.
+    pub paper: Option<PaperCell>,
+}
+
+/// A table of the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Table {
+    /// Short id: "1", "4"-"7", "2", "3" or "gomez".
+    pub id: String,
+    /// Title.
+    pub title: String,
+    /// What p is against, when the table has p.
+    pub p_against: Option<String>,
+    /// The rows.
+    pub rows: Vec<Row>,
+}
+
+/// Burst mutations of one configuration.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BurstRow {
+    /// The configuration.
+    pub config: GridConfig,
+    /// Runs counted.
+    pub runs: usize,
+    /// Total burst mutations.
+    pub total: usize,
+    /// Mean per run.
+    pub per_run: f64,
+    /// Sample sd per run.
+    pub sd: f64,
+    /// The paper's total over its 90 runs, if given.
+    pub paper_total: Option<usize>,
+}
+
+/// The missing and unfinished runs of one (configuration, task).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MissingCell {
+    /// The configuration.
+    pub config: GridConfig,
+    /// The task.
+    pub task: Task,
+    /// Runs not started.
+    pub missing: usize,
+    /// Runs started but not finished.
+    pub unfinished: usize,
+    /// A few of their folders.
+    pub examples: Vec<String>,
+}
+
+/// A figure, linked relative to the grid directory.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FigureLink {
+    /// Caption.
+    pub title: String,
+    /// PNG path relative to the grid directory.
+    pub png: String,
+    /// SVG path relative to the grid directory.
+    pub svg: String,
+}
+
+/// Runs from one build.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BuildCount {
+    /// The build.
+    pub build: BuildInfo,
+    /// Runs made with it.
+    pub runs: usize,
+}
+
+/// The whole report (what `report.json` holds).
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// The grid's definition.
+    pub grid: GridSpec,
+    /// How the grid falls short of the paper's protocol (empty: it does not).
+    pub reduced: Vec<String>,
+    /// The builds that made the counted runs.
+    pub builds: Vec<BuildCount>,
+    /// Wall-clock seconds of the counted runs, added up.
+    pub compute_seconds: f64,
+    /// Runs of the grid.
+    pub runs_expected: usize,
+    /// Runs counted.
+    pub runs_counted: usize,
+    /// Missing and unfinished runs per (configuration, task).
+    pub missing: Vec<MissingCell>,
+    /// Damaged or foreign run folders (not counted).
+    pub problems: Vec<Problem>,
+    /// Tables 1, 4, 5, 6, 7, Gomez's ESP (when the grid runs it), then 2
+    /// and 3.
+    pub tables: Vec<Table>,
+    /// Burst mutations per configuration.
+    pub bursts: Vec<BurstRow>,
+    /// The paper's findings, judged here.
+    pub findings: Vec<Finding>,
+    /// The distance to the paper (`docs/model.md`).
+    pub distance: Distance,
+    /// The figures written.
+    pub figures: Vec<FigureLink>,
+    /// Figures that could not be drawn.
+    pub figure_problems: Vec<String>,
+}
+
+/// The champion tables: id, title, configurations.
+const CHAMPION_TABLES: [(&str, &str, &[GridConfig]); 6] = [
+    (
+        "1",
+        "Table 1: baseline ESP (burst mutation discards all sub-populations)",
+        &[BASELINE],
+    ),
+    (
+        "4",
+        "Table 4: systematic sampling",
+        &[GridConfig::Preset(Preset::Systematic)],
+    ),
+    ("5", "Table 5: max credit", &[GridConfig::Preset(Preset::MaxCredit)]),
+    (
+        "6",
+        "Table 6: lesion tests off; erase the best network",
+        &[
+            GridConfig::Preset(Preset::LesionOff),
+            GridConfig::Preset(Preset::EraseBest),
+        ],
+    ),
+    ("7", "Table 7: hill-climbing", &[GridConfig::Preset(Preset::HillClimb)]),
+    (
+        "gomez",
+        "Gomez's ESP (burst mutation keeps sub-populations added since the best network was found; not in the paper)",
+        &[GridConfig::Preset(Preset::Gomez)],
+    ),
+];
+
+impl Report {
+    /// The report of `results` (figures not yet drawn).
+    pub fn from_results(results: &GridResults) -> Report {
+        let spec = &results.spec;
+        // The paper's tables always (a grid without their runs shows them
+        // missing); another configuration's only when the grid runs it.
+        let shown = |configs: &[GridConfig]| {
+            configs.iter().all(|c| c.in_paper()) || configs.iter().any(|c| spec.configs.contains(c))
+        };
+        let mut tables: Vec<Table> = CHAMPION_TABLES
+            .iter()
+            .filter(|(_, _, configs)| shown(configs))
+            .map(|(id, title, configs)| champion_table(results, id, title, configs))
+            .collect();
+        tables.extend(robustness_tables(results));
+        Report {
+            grid: spec.clone(),
+            reduced: reductions(spec),
+            builds: builds(results),
+            compute_seconds: results.runs.iter().map(|r| r.summary.seconds).sum(),
+            runs_expected: spec.runs().len(),
+            runs_counted: results.runs.len(),
+            missing: missing_cells(results),
+            problems: results.problems.clone(),
+            tables,
+            bursts: burst_rows(results),
+            findings: findings(results),
+            distance: Distance::of(results),
+            figures: Vec::new(),
+            figure_problems: Vec::new(),
+        }
+    }
+
+    /// Missing and unfinished runs in all.
+    pub fn incomplete_runs(&self) -> (usize, usize) {
+        self.missing
+            .iter()
+            .fold((0, 0), |(m, u), c| (m + c.missing, u + c.unfinished))
+    }
+}
+
+/// The task columns: each task alone, then All (the grid's tasks pooled).
+fn task_columns(spec: &GridSpec) -> Vec<(String, Vec<Task>, Option<Task>)> {
+    let mut columns: Vec<_> = Task::ALL
+        .iter()
+        .map(|&t| (t.number().to_string(), vec![t], Some(t)))
+        .collect();
+    columns.push(("All".into(), spec.tasks.clone(), None));
+    columns
+}
+
+/// A row: `config`'s `metric` on `tasks`, with p against `reference`'s `reference_metric`.
+fn row(
+    results: &GridResults,
+    config: GridConfig,
+    metric: Metric,
+    (label, tasks, paper_task): &(String, Vec<Task>, Option<Task>),
+    reference: Option<(GridConfig, Metric)>,
+) -> Row {
+    let values = results.values(config, tasks, metric);
+    let (mean, sd) = mean_sd(&values);
+    let p = reference.map(|(c, m)| welch(&values, &results.values(c, tasks, m)).p);
+    Row {
+        config,
+        metric,
+        task: label.clone(),
+        n: values.len(),
+        mean,
+        sd,
+        p,
+        paper: paper_cell(config, metric, *paper_task),
+    }
+}
+
+fn champion_table(results: &GridResults, id: &str, title: &str, configs: &[GridConfig]) -> Table {
+    let reference = (configs != [BASELINE]).then_some((BASELINE, Metric::Champion));
+    let rows = configs
+        .iter()
+        .flat_map(|&config| {
+            task_columns(&results.spec)
+                .iter()
+                .map(|column| row(results, config, Metric::Champion, column, reference))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    Table {
+        id: id.into(),
+        title: title.into(),
+        p_against: reference.map(|_| "baseline (Table 1)".into()),
+        rows,
+    }
+}
+
+/// The rows of `config`'s champions under `metric`: tasks 1-3 and All, or
+/// for random initialisation tasks 1 and 3 only (as in the paper).
+fn robustness_rows(
+    results: &GridResults,
+    config: GridConfig,
+    metric: Metric,
+    reference: Option<(GridConfig, Metric)>,
+) -> Vec<Row> {
+    task_columns(&results.spec)
+        .iter()
+        .filter(|(_, tasks, task)| metric != Metric::RandomInit || (task.is_some() && tasks[0].has_random_init()))
+        .map(|column| row(results, config, metric, column, reference))
+        .collect()
+}
+
+fn robustness_tables(results: &GridResults) -> [Table; 2] {
+    let mut table2 = robustness_rows(results, BASELINE, Metric::Clean, None);
+    table2.extend(robustness_rows(results, BASELINE, Metric::InputNoise, None));
+    table2.extend(robustness_rows(results, BASELINE, Metric::RandomInit, None));
+    let mut table3 = robustness_rows(
+        results,
+        GridConfig::InputNoise,
+        Metric::InputNoise,
+        Some((BASELINE, Metric::InputNoise)),
+    );
+    table3.extend(robustness_rows(
+        results,
+        GridConfig::RandomInit,
+        Metric::RandomInit,
+        Some((BASELINE, Metric::RandomInit)),
+    ));
+    [
+        Table {
+            id: "2".into(),
+            title: "Table 2: baseline champions flown clean, under input noise and from random initial conditions".into(),
+            p_against: None,
+            rows: table2,
+        },
+        Table {
+            id: "3".into(),
+            title: "Table 3: champions evolved under input noise (tested under input noise) and under random initialisation (tested from random initial conditions)".into(),
+            p_against: Some("the baseline champions under the same test (Table 2)".into()),
+            rows: table3,
+        },
+    ]
+}
+
+fn burst_rows(results: &GridResults) -> Vec<BurstRow> {
+    let spec = &results.spec;
+    spec.configs
+        .iter()
+        .map(|&config| {
+            let values = results.values(config, &spec.tasks, Metric::Bursts);
+            let (per_run, sd) = mean_sd(&values);
+            BurstRow {
+                config,
+                runs: values.len(),
+                total: values.iter().sum::<f64>() as usize,
+                per_run,
+                sd,
+                paper_total: paper_bursts(config),
+            }
+        })
+        .collect()
+}
+
+/// How `spec` falls short of the paper's protocol.
+pub(super) fn reductions(spec: &GridSpec) -> Vec<String> {
+    let paper = GridSpec::from_preset(GridPreset::Paper);
+    let mut reduced = Vec::new();
+    let mut less = |what: &str, here: usize, there: usize| {
+        if here < there {
+            reduced.push(format!("{here} {what} instead of {there}"));
+        }
+    };
+    less(
+        "seeds per configuration and task",
+        spec.seeds as usize,
+        paper.seeds as usize,
+    );
+    less("generations per run", spec.generations, paper.generations);
+    less(
+        "trials per robustness test",
+        spec.robustness_trials,
+        paper.robustness_trials,
+    );
+    let absent: Vec<&str> = paper
+        .configs
+        .iter()
+        .filter(|c| !spec.configs.contains(c))
+        .map(|c| c.name())
+        .collect();
+    if !absent.is_empty() {
+        reduced.push(format!("configurations left out: {}", absent.join(", ")));
+    }
+    let absent: Vec<String> = paper
+        .tasks
+        .iter()
+        .filter(|t| !spec.tasks.contains(t))
+        .map(|t| t.to_string())
+        .collect();
+    if !absent.is_empty() {
+        reduced.push(format!("tasks left out: {}", absent.join(", ")));
+    }
+    reduced
+}
+
+fn builds(results: &GridResults) -> Vec<BuildCount> {
+    let mut counts: BTreeMap<&BuildInfo, usize> = BTreeMap::new();
+    for run in &results.runs {
+        *counts.entry(&run.summary.build).or_default() += 1;
+    }
+    counts
+        .into_iter()
+        .map(|(build, runs)| BuildCount {
+            build: build.clone(),
+            runs,
+        })
+        .collect()
+}
+
+/// Examples of folders listed per (configuration, task).
+const MISSING_EXAMPLES: usize = 2;
+
+fn missing_cells(results: &GridResults) -> Vec<MissingCell> {
+    let mut cells: Vec<MissingCell> = Vec::new();
+    for run in &results.incomplete {
+        let (config, task) = (run.key.config, run.key.task);
+        let index = match cells.iter().position(|c| c.config == config && c.task == task) {
+            Some(i) => i,
+            None => {
+                cells.push(MissingCell {
+                    config,
+                    task,
+                    missing: 0,
+                    unfinished: 0,
+                    examples: Vec::new(),
+                });
+                cells.len() - 1
+            }
+        };
+        let cell = &mut cells[index];
+        match run.status {
+            RunStatus::Unfinished => cell.unfinished += 1,
+            _ => cell.missing += 1,
+        }
+        if cell.examples.len() < MISSING_EXAMPLES {
+            cell.examples.push(run.folder.display().to_string());
+        }
+    }
+    cells
+}

@@ -1,0 +1,118 @@
+//! Re-scoring a finished grid without re-evolving it: every finished run's
+//! champion tested again under other scoring settings (a TOML document laid
+//! over each run's configuration for its tests only), into a new grid
+//! folder that `psa-esp report` reads like any other.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
+
+use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
+use super::grid_run::{mark_finished, run_seed, score_champion};
+use super::replicate::prepare;
+use super::shard::Shard;
+
+/// The files of a run that re-scoring copies unchanged (its evolution).
+const EVOLUTION_FILES: [&str; 4] = ["config.toml", "records.csv", "champion.json", "run.json"];
+
+/// What [`rescore`] did.
+#[derive(Debug, Clone)]
+pub struct RescoreSummary {
+    /// Finished runs of the source grid.
+    pub total: usize,
+    /// Runs of the source grid not finished (left out).
+    pub unfinished: usize,
+    /// Runs already re-scored in the output folder (a resumed re-scoring).
+    pub skipped: usize,
+    /// Runs re-scored now.
+    pub ran: usize,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// The re-scored grid's definition: `source`'s with `overlay` laid over its
+/// rescoring (a grid re-scored twice keeps both, the later on top), no ODE
+/// check, and `trials` robustness trials when given.
+pub fn rescored_spec(source: &GridSpec, overlay: &str, trials: Option<usize>) -> Result<GridSpec> {
+    let mut table: toml::Table = match &source.rescoring {
+        Some(text) => toml::from_str(text).context("the source grid's rescoring")?,
+        None => toml::Table::new(),
+    };
+    let added: toml::Table = toml::from_str(overlay).context("the rescoring settings")?;
+    super::config::merge(&mut table, added);
+    let spec = GridSpec {
+        rescoring: Some(toml::to_string(&table)?),
+        ode_check: false,
+        robustness_trials: trials.unwrap_or(source.robustness_trials),
+        ..source.clone()
+    };
+    spec.validate()?;
+    for config in &spec.configs {
+        let scoring = spec.scoring_config(*config)?;
+        let evolution = spec.run_config(*config)?;
+        if scoring.esp != evolution.esp
+            || scoring.hill_climb != evolution.hill_climb
+            || scoring.algorithm != evolution.algorithm
+        {
+            bail!("the rescoring settings change the search ({config}); re-scoring can change the problem's settings only");
+        }
+    }
+    Ok(spec)
+}
+
+/// Re-tests every finished run of the grid in `source` under `spec` (made
+/// by [`rescored_spec`]) into `out`, on `threads` threads (0: one per
+/// core): each run's evolution files copied, its `robustness.json` written
+/// anew, last. Running it again resumes; results do not depend on threads.
+pub fn rescore(source: &Path, out: &Path, spec: &GridSpec, threads: usize) -> Result<RescoreSummary> {
+    let clock = Instant::now();
+    let source_spec = GridSpec::load(source)?;
+    if std::fs::canonicalize(source).ok() == std::fs::canonicalize(out).ok() {
+        bail!(
+            "--out {} is the grid being re-scored; re-scoring writes a new grid folder",
+            out.display()
+        );
+    }
+    let mut finished = Vec::new();
+    let mut unfinished = 0;
+    for key in source_spec.runs() {
+        match run_status(source, &source_spec, &key)? {
+            RunStatus::Finished => finished.push(key),
+            RunStatus::Missing | RunStatus::Unfinished => unfinished += 1,
+        }
+    }
+    let (todo, _) = prepare(out, spec, Shard::ALL)?;
+    let todo: Vec<RunKey> = todo.into_iter().filter(|k| finished.contains(k)).collect();
+    let skipped = finished.len() - todo.len();
+    let pool = crate::ode::thread_pool(threads)?;
+    pool.install(|| {
+        todo.par_iter()
+            .with_max_len(1)
+            .map(|key| rescore_run(source, out, spec, key))
+            .collect::<Result<Vec<()>>>()
+    })?;
+    Ok(RescoreSummary {
+        total: finished.len(),
+        unfinished,
+        skipped,
+        ran: todo.len(),
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+/// Copies run `key`'s evolution files from `source` into `out` and writes
+/// its robustness tests under `spec`'s scoring.
+fn rescore_run(source: &Path, out: &Path, spec: &GridSpec, key: &RunKey) -> Result<()> {
+    let (from, to) = (run_dir(source, key), run_dir(out, key));
+    std::fs::create_dir_all(&to).with_context(|| format!("cannot create {}", to.display()))?;
+    for name in EVOLUTION_FILES {
+        let bytes =
+            std::fs::read(from.join(name)).with_context(|| format!("cannot read {}", from.join(name).display()))?;
+        crate::io::write_atomic(&to.join(name), &bytes)?;
+    }
+    let (_, _, robustness) =
+        score_champion(&to, spec, key, run_seed(key)).with_context(|| format!("re-scoring {}", from.display()))?;
+    mark_finished(&to, &robustness)
+}

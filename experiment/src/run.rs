@@ -1,0 +1,253 @@
+//! One evolution run, written to its own directory.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::{Algorithm, RunConfig};
+use crate::columns::{header, row, Column};
+use crate::evaluator::{EvalPath, PsaEvaluator};
+use crate::evolution::{Esp, GenerationRecord, HillClimb, LesionOutcome, RunResult};
+use crate::io::write_atomic;
+use crate::psa::{NetworkFile, Task};
+use crate::results::EvolveOutcome;
+use anyhow::{Context, Result};
+
+/// The files of a run directory.
+#[derive(Debug, Clone)]
+pub struct RunFiles {
+    /// The resolved configuration (`config.toml`).
+    pub config: PathBuf,
+    /// One row per generation (`records.csv`).
+    pub records: PathBuf,
+    /// The champion network (`champion.json`).
+    pub champion: PathBuf,
+    /// Task, seed, results, build and times (`run.json`).
+    pub summary: PathBuf,
+}
+
+impl RunFiles {
+    /// The files of the run directory `dir`.
+    pub fn in_dir(dir: &Path) -> RunFiles {
+        RunFiles {
+            config: dir.join("config.toml"),
+            records: dir.join("records.csv"),
+            champion: dir.join("champion.json"),
+            summary: dir.join("run.json"),
+        }
+    }
+}
+
+/// The columns of `records.csv`, one row per generation (hill-climber: per
+/// cycle); fitness in % of the task's theoretical maximum.
+pub const RECORD_COLUMNS: [Column<GenerationRecord>; 11] = [
+    Column {
+        name: "generation",
+        doc: "the generation (hill-climber: the cycle), from 1",
+        value: |r| r.generation.to_string(),
+    },
+    Column {
+        name: "min",
+        doc: "the lowest network fitness of the generation",
+        value: |r| r.min.to_string(),
+    },
+    Column {
+        name: "mean",
+        doc: "the mean network fitness of the generation",
+        value: |r| r.mean.to_string(),
+    },
+    Column {
+        name: "max",
+        doc: "the highest network fitness of the generation",
+        value: |r| r.max.to_string(),
+    },
+    Column {
+        name: "best",
+        doc: "the search's best network fitness so far (empty right after `erase_best` forgot it)",
+        value: |r| r.best.map_or(String::new(), |b| b.to_string()),
+    },
+    Column {
+        name: "champion",
+        doc: "the champion's fitness: the best network ever evaluated",
+        value: |r| r.champion.to_string(),
+    },
+    Column {
+        name: "evaluations",
+        doc: "network evaluations so far, lesion tests included",
+        value: |r| r.evaluations.to_string(),
+    },
+    Column {
+        name: "subpops",
+        doc: "sub-populations after the generation",
+        value: |r| r.subpops.to_string(),
+    },
+    Column {
+        name: "burst",
+        doc: "whether the generation ended in a burst mutation (`true` or `false`)",
+        value: |r| r.burst.to_string(),
+    },
+    Column {
+        name: "bursts",
+        doc: "burst mutations so far",
+        value: |r| r.bursts.to_string(),
+    },
+    Column {
+        name: "lesion",
+        doc: "the lesion test's outcome: `add`, `remove K` or empty",
+        value: |r| match r.lesion {
+            None => String::new(),
+            Some(LesionOutcome::Add) => "add".into(),
+            Some(LesionOutcome::Remove { neuron }) => format!("remove {neuron}"),
+        },
+    },
+];
+
+/// One line of `records.csv`, with its line break.
+fn record_line(r: &GenerationRecord) -> String {
+    row(&RECORD_COLUMNS, r) + "\n"
+}
+
+/// The records as CSV, one row per generation.
+pub fn records_csv(records: &[GenerationRecord]) -> String {
+    let mut csv = header(&RECORD_COLUMNS) + "\n";
+    for r in records {
+        csv.push_str(&record_line(r));
+    }
+    csv
+}
+
+/// `records.csv` while the run goes: a line written and flushed per
+/// generation, so that it can be watched (`tail -f`). The finished run
+/// replaces it atomically with the whole file; should a live write fail,
+/// live writing stops and the run goes on.
+struct LiveRecords {
+    file: Option<std::fs::File>,
+}
+
+impl LiveRecords {
+    fn create(path: &Path) -> LiveRecords {
+        let file = std::fs::File::create(path).and_then(|mut f| {
+            f.write_all((header(&RECORD_COLUMNS) + "\n").as_bytes())?;
+            Ok(f)
+        });
+        LiveRecords { file: file.ok() }
+    }
+
+    fn push(&mut self, record: &GenerationRecord) {
+        if let Some(file) = &mut self.file {
+            if file
+                .write_all(record_line(record).as_bytes())
+                .and_then(|_| file.flush())
+                .is_err()
+            {
+                self.file = None;
+            }
+        }
+    }
+}
+
+/// Runs `config` on `task` with `seed` on the current rayon pool and writes
+/// `config.toml`, `records.csv`, `champion.json` and `run.json` (each
+/// atomically) into `dir`; `records.csv` also grows a line per generation
+/// while the run goes; its networks are evaluated on `path`. `on_generation`
+/// sees every record as it comes.
+pub fn run_evolution(
+    config: &RunConfig,
+    label: &str,
+    task: Task,
+    seed: u64,
+    dir: &Path,
+    path: &EvalPath,
+    mut on_generation: impl FnMut(&GenerationRecord),
+) -> Result<EvolveOutcome> {
+    let mut started = RunStart::new(config, dir)?;
+    let evaluator = PsaEvaluator::new(config.problem.clone(), task, path)?;
+    let on_generation = |record: &GenerationRecord| {
+        started.record(record);
+        on_generation(record);
+    };
+    let result: RunResult = match config.algorithm {
+        Algorithm::Esp => Esp::new(config.esp.clone(), seed)
+            .map_err(anyhow::Error::msg)?
+            .run(&evaluator, on_generation)?,
+        Algorithm::HillClimb => HillClimb::new(config.hill_climb.clone(), seed)
+            .map_err(anyhow::Error::msg)?
+            .run(&evaluator, on_generation)?,
+    };
+    started.finish(config, label, task, seed, &result)
+}
+
+/// A run begun on disk: its folder made, `config.toml` written and
+/// `records.csv` growing a line per generation; its start time and clock.
+pub struct RunStart {
+    files: RunFiles,
+    live: LiveRecords,
+    started: String,
+    clock: Instant,
+}
+
+impl RunStart {
+    /// Checks `config`, makes `dir` and writes `config.toml` into it.
+    pub fn new(config: &RunConfig, dir: &Path) -> Result<RunStart> {
+        config.validate()?;
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        let files = RunFiles::in_dir(dir);
+        write_atomic(&files.config, config.to_toml()?.as_bytes())?;
+        let live = LiveRecords::create(&files.records);
+        Ok(RunStart {
+            files,
+            live,
+            started: crate::provenance::now_rfc3339(),
+            clock: Instant::now(),
+        })
+    }
+
+    /// Appends one generation's line to the live `records.csv`.
+    pub fn record(&mut self, record: &GenerationRecord) {
+        self.live.push(record);
+    }
+
+    /// Writes the run's `result` (`records.csv` whole and atomically,
+    /// `champion.json`, `run.json`).
+    pub fn finish(
+        self,
+        config: &RunConfig,
+        label: &str,
+        task: Task,
+        seed: u64,
+        result: &RunResult,
+    ) -> Result<EvolveOutcome> {
+        let files = self.files;
+        let seconds = self.clock.elapsed().as_secs_f64();
+        write_atomic(&files.records, records_csv(&result.records).as_bytes())?;
+        let champion = &result.champion;
+        let mut extra = serde_json::Map::new();
+        extra.insert("configuration".into(), label.into());
+        extra.insert("seed".into(), seed.to_string().into());
+        extra.insert("fitness_percent".into(), champion.fitness.into());
+        extra.insert("generation".into(), champion.generation.into());
+        extra.insert("backend".into(), config.problem.backend.name().into());
+        let build = crate::build_info();
+        NetworkFile::new(&champion.network, task, &config.problem, &build, extra).save(&files.champion)?;
+        let last = result.records.last().context("a run has at least one generation")?;
+        let outcome = EvolveOutcome {
+            task,
+            seed,
+            label: label.to_string(),
+            backend: config.problem.backend,
+            champion_fitness: champion.fitness,
+            champion_generation: champion.generation,
+            generations: result.records.len(),
+            evaluations: last.evaluations,
+            bursts: last.bursts,
+            champion_hidden: champion.network.hidden(),
+            build,
+            started: self.started,
+            finished: crate::provenance::now_rfc3339(),
+            seconds,
+            ode_check: None,
+        };
+        outcome.save(&files.summary)?;
+        Ok(outcome)
+    }
+}

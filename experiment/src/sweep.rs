@@ -1,0 +1,555 @@
+//! `psa-esp sweep`: the replication grid once for each value (or each
+//! combination of values) of any settings. Every variant is an ordinary
+//! grid folder under `DIR/variants/`, with the variant's settings recorded
+//! as its grid's overrides, so it resumes, reports and seeds exactly as a
+//! `replicate` grid does (the same seeds in every variant: the variants
+//! differ by their settings only).
+//!
+//! ```text
+//! DIR/sweep.json                      the sweep's definition
+//! DIR/variants/<variant>/grid.json    an ordinary grid (see `grid`)
+//! DIR/variants/<variant>/runs/...
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+
+use super::grid::GridSpec;
+use super::replicate::{replicate, GridProgress, HeldRun, ReplicateOptions, ReplicateSummary};
+use super::RunConfig;
+
+/// The `format` of `sweep.json`.
+pub const SWEEP_FORMAT: &str = "psa-esp-sweep";
+/// Its version.
+pub const SWEEP_VERSION: u32 = 1;
+
+/// One varied setting: a dotted key of the configuration file and its values.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Vary {
+    /// The setting, e.g. `esp.stagnation` or `problem.tasks.task3_speed`.
+    pub key: String,
+    /// Its values, each written as a TOML value (`0.1`, `"phase_best"`, `[0.0, 0.1]`).
+    pub values: Vec<String>,
+}
+
+/// How the varied settings combine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SweepMode {
+    /// Every combination of the values (the Cartesian product).
+    Combinations,
+    /// One setting at a time, the others at the base; plus the base itself.
+    OneAtATime,
+}
+
+impl SweepMode {
+    /// Every mode.
+    pub const ALL: [SweepMode; 2] = [SweepMode::Combinations, SweepMode::OneAtATime];
+
+    /// The mode's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepMode::Combinations => "combinations",
+            SweepMode::OneAtATime => "one-at-a-time",
+        }
+    }
+}
+
+/// One variant: its name (its folder) and its settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Variant {
+    /// Folder name under `variants/`.
+    pub name: String,
+    /// (key, TOML value) for every varied setting the variant sets.
+    pub settings: Vec<(String, String)>,
+}
+
+/// A sweep's definition, written to `sweep.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepSpec {
+    /// Always [`SWEEP_FORMAT`].
+    pub format: String,
+    /// Always [`SWEEP_VERSION`].
+    pub version: u32,
+    /// The grid every variant runs (its `overrides` is the base configuration file, if any).
+    pub grid: GridSpec,
+    /// The varied settings.
+    pub vary: Vec<Vary>,
+    /// How they combine.
+    pub mode: SweepMode,
+}
+
+/// Splits `KEY=V1,V2,...` into the key and its values; commas inside
+/// brackets or quotes belong to the value (`task2_velocity=[0.1,0],[0.2,0]`).
+pub fn parse_vary(text: &str) -> Result<Vary> {
+    let (key, values) = text
+        .split_once('=')
+        .with_context(|| format!("--vary {text:?}: expected KEY=VALUE,VALUE,..."))?;
+    let key = key.trim();
+    if key.is_empty() || !key.split('.').all(|part| !part.is_empty()) {
+        bail!("--vary {text:?}: {key:?} is not a dotted setting name such as esp.stagnation");
+    }
+    let mut parts = Vec::new();
+    let (mut depth, mut quoted, mut current) = (0i32, false, String::new());
+    for c in values.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            '[' if !quoted => depth += 1,
+            ']' if !quoted => depth -= 1,
+            ',' if !quoted && depth == 0 => {
+                parts.push(std::mem::take(&mut current));
+                continue;
+            }
+            _ => {}
+        }
+        current.push(c);
+    }
+    parts.push(current);
+    let values: Vec<String> = parts.iter().map(|v| toml_value(v.trim())).collect::<Result<_>>()?;
+    if values.iter().any(|v| v.is_empty()) {
+        bail!("--vary {text:?}: an empty value");
+    }
+    let mut seen = std::collections::HashSet::new();
+    if let Some(dup) = values.iter().find(|v| !seen.insert(v.as_str())) {
+        bail!("--vary {text:?}: the value {dup} is given twice");
+    }
+    Ok(Vary {
+        key: key.to_string(),
+        values,
+    })
+}
+
+/// `text` as a TOML value: as written when it parses as one (numbers,
+/// booleans, arrays, quoted strings), else as a string (`phase_best`).
+fn toml_value(text: &str) -> Result<String> {
+    if text.is_empty() {
+        return Ok(String::new());
+    }
+    let parsed = format!("v = {text}").parse::<toml::Table>();
+    match parsed {
+        Ok(table) => Ok(table["v"].to_string()),
+        Err(_) if text.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) => {
+            Ok(toml::Value::String(text.to_string()).to_string())
+        }
+        Err(e) => bail!("{text:?} is not a TOML value: {}", e.message()),
+    }
+}
+
+impl SweepSpec {
+    /// A sweep of `grid` over `vary`, checked: distinct keys, every
+    /// variant a valid configuration (the error names the variant and key).
+    pub fn new(grid: GridSpec, vary: Vec<Vary>, mode: SweepMode) -> Result<SweepSpec> {
+        if vary.is_empty() {
+            bail!("a sweep needs at least one --vary KEY=VALUES");
+        }
+        for (i, v) in vary.iter().enumerate() {
+            if vary[..i].iter().any(|w| w.key == v.key) {
+                bail!("--vary {}: the setting is varied twice", v.key);
+            }
+        }
+        let spec = SweepSpec {
+            format: SWEEP_FORMAT.into(),
+            version: SWEEP_VERSION,
+            grid,
+            vary,
+            mode,
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// Checks every variant's grid.
+    pub fn validate(&self) -> Result<()> {
+        let variants = self.variants();
+        const MAX_VARIANTS: usize = 10_000;
+        if variants.len() > MAX_VARIANTS {
+            bail!(
+                "the sweep has {} variants; at most {MAX_VARIANTS} are allowed",
+                variants.len()
+            );
+        }
+        for variant in &variants {
+            self.variant_grid(variant)
+                .and_then(|grid| grid.validate())
+                .with_context(|| format!("variant {}", variant.name))?;
+        }
+        Ok(())
+    }
+
+    /// The variants, in a fixed order.
+    pub fn variants(&self) -> Vec<Variant> {
+        let settings: Vec<Vec<(String, String)>> = match self.mode {
+            SweepMode::Combinations => self.vary.iter().fold(vec![Vec::new()], |acc, v| {
+                acc.iter()
+                    .flat_map(|prefix| {
+                        v.values.iter().map(move |value| {
+                            let mut s = prefix.clone();
+                            s.push((v.key.clone(), value.clone()));
+                            s
+                        })
+                    })
+                    .collect()
+            }),
+            SweepMode::OneAtATime => std::iter::once(Vec::new())
+                .chain(
+                    self.vary
+                        .iter()
+                        .flat_map(|v| v.values.iter().map(|value| vec![(v.key.clone(), value.clone())])),
+                )
+                .collect(),
+        };
+        let width = settings.len().to_string().len();
+        settings
+            .into_iter()
+            .enumerate()
+            .map(|(i, settings)| Variant {
+                name: variant_name(i, width, &settings),
+                settings,
+            })
+            .collect()
+    }
+
+    /// The grid of `variant`: the sweep's grid with the variant's settings
+    /// laid over its base configuration file.
+    pub fn variant_grid(&self, variant: &Variant) -> Result<GridSpec> {
+        let mut table: toml::Table = match &self.grid.overrides {
+            Some(text) => text.parse().context("the base configuration")?,
+            None => toml::Table::new(),
+        };
+        for (key, value) in &variant.settings {
+            set_dotted(&mut table, key, value)?;
+        }
+        // Unknown keys and bad values are named here, before any run.
+        RunConfig::baseline_with(&toml::to_string(&table)?).with_context(|| {
+            let settings: Vec<String> = variant.settings.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+            format!("settings {}", settings.join(", "))
+        })?;
+        let mut grid = self.grid.clone();
+        grid.overrides = (!table.is_empty()).then(|| toml::to_string(&table)).transpose()?;
+        Ok(grid)
+    }
+
+    /// Reads `DIR/sweep.json`, checking its format and version.
+    pub fn load(dir: &Path) -> Result<SweepSpec> {
+        let path = sweep_file(dir);
+        let spec: SweepSpec = crate::io::read_versioned_json(&path, SWEEP_FORMAT, SWEEP_VERSION, "sweep")?;
+        spec.validate().with_context(|| format!("{}", path.display()))?;
+        Ok(spec)
+    }
+
+    /// Writes `DIR/sweep.json` atomically.
+    pub fn save(&self, dir: &Path) -> Result<()> {
+        crate::io::write_json(&sweep_file(dir), self)
+    }
+}
+
+/// `DIR/sweep.json`.
+pub fn sweep_file(dir: &Path) -> PathBuf {
+    dir.join("sweep.json")
+}
+
+/// The folder of a variant.
+pub fn variant_dir(dir: &Path, variant: &Variant) -> PathBuf {
+    dir.join("variants").join(&variant.name)
+}
+
+/// `v03-esp.stagnation=40+problem.tasks.task3_speed=0.2`, with characters
+/// that do not belong in a folder name replaced by `_`; `v00-base` for none.
+fn variant_name(index: usize, width: usize, settings: &[(String, String)]) -> String {
+    let body = if settings.is_empty() {
+        "base".to_string()
+    } else {
+        settings
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join("+")
+    };
+    let clean: String = body
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._=+-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("v{index:0width$}-{clean}")
+}
+
+/// Sets `a.b.c = value` in `table`, creating the tables on the way.
+fn set_dotted(table: &mut toml::Table, key: &str, value: &str) -> Result<()> {
+    let parsed: toml::Table = format!("v = {value}")
+        .parse()
+        .with_context(|| format!("{key} = {value}"))?;
+    let value = parsed["v"].clone();
+    let mut parts: Vec<&str> = key.split('.').collect();
+    let last = parts.pop().context("an empty key")?;
+    let mut current = table;
+    for part in parts {
+        let entry = current
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        current = entry
+            .as_table_mut()
+            .with_context(|| format!("{key}: {part} is a value, not a table"))?;
+    }
+    current.insert(last.to_string(), value);
+    Ok(())
+}
+
+/// What [`sweep`] did.
+#[derive(Debug, Clone)]
+pub struct SweepSummary {
+    /// Variants.
+    pub variants: usize,
+    /// Runs over all variants.
+    pub total: usize,
+    /// Runs already finished.
+    pub skipped: usize,
+    /// Runs done now.
+    pub ran: usize,
+    /// Runs other processes were running, left to them (with their variant).
+    pub held: Vec<(String, HeldRun)>,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// Runs every variant's grid in `dir` (a new folder gets `sweep.json`; an
+/// existing sweep must have the same definition), variant after variant.
+/// `options.shard` splits the sweep's whole run order (the variants' run
+/// orders one after another), round-robin as a grid's.
+pub fn sweep(
+    dir: &Path,
+    spec: &SweepSpec,
+    options: &ReplicateOptions,
+    progress: &dyn GridProgress,
+) -> Result<SweepSummary> {
+    prepare(dir, spec)?;
+    let variants = spec.variants();
+    let mut summary = SweepSummary {
+        variants: variants.len(),
+        total: 0,
+        skipped: 0,
+        ran: 0,
+        held: Vec::new(),
+        seconds: 0.0,
+    };
+    let mut before = 0;
+    for variant in &variants {
+        let grid = spec.variant_grid(variant)?;
+        let variant_options = ReplicateOptions {
+            shard: options.shard.after(before),
+            ..options.clone()
+        };
+        before += grid.runs().len();
+        let ReplicateSummary {
+            total,
+            skipped,
+            ran,
+            held,
+            seconds,
+        } = replicate(&variant_dir(dir, variant), &grid, &variant_options, progress)
+            .with_context(|| format!("variant {}", variant.name))?;
+        summary.total += total;
+        summary.skipped += skipped;
+        summary.ran += ran;
+        summary.held.extend(held.into_iter().map(|h| (variant.name.clone(), h)));
+        summary.seconds += seconds;
+    }
+    Ok(summary)
+}
+
+/// Creates `dir` with `sweep.json` (of processes starting together,
+/// exactly one writes it), or checks that it holds the same sweep.
+fn prepare(dir: &Path, spec: &SweepSpec) -> Result<()> {
+    // The folder's contents first: they appear only after its sweep.json.
+    if dir.read_dir().is_ok_and(|mut d| d.next().is_some()) && !sweep_file(dir).exists() {
+        bail!(
+            "{} exists and is not a sweep folder (no sweep.json); use another --out",
+            dir.display()
+        );
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut json = serde_json::to_string_pretty(spec)?;
+    json.push('\n');
+    if !sweep_file(dir).exists() && crate::io::create_new_atomic(&sweep_file(dir), json.as_bytes())? {
+        return Ok(());
+    }
+    let existing = SweepSpec::load(dir)?;
+    if existing != *spec {
+        bail!(
+            "{} holds a sweep with another definition; resume it with the same options or use another --out",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::GridPreset;
+
+    #[test]
+    fn values_split_at_top_level_commas_and_read_as_toml() {
+        let v = parse_vary("problem.tasks.task2_velocity=[0.1, 0],[0.2,0]").unwrap();
+        assert_eq!(v.values, ["[0.1, 0]", "[0.2, 0]"]);
+        let v = parse_vary("esp.stagnation_rule=phase_best,all_time_best").unwrap();
+        assert_eq!(v.values, ["\"phase_best\"", "\"all_time_best\""]);
+        let v = parse_vary("esp.stagnation=20,40").unwrap();
+        assert_eq!(v.values, ["20", "40"]);
+        assert!(parse_vary("esp.stagnation").is_err());
+        assert!(parse_vary("esp.stagnation=20,20").is_err());
+        assert!(parse_vary("esp..x=1").is_err());
+        assert!(parse_vary("esp.stagnation=20,,40").is_err());
+    }
+
+    fn spec(mode: SweepMode) -> Result<SweepSpec> {
+        SweepSpec::new(
+            GridSpec::from_preset(GridPreset::Quick),
+            vec![
+                parse_vary("esp.stagnation=20,40")?,
+                parse_vary("problem.tasks.task3_speed=0.1,0.2,0.3")?,
+            ],
+            mode,
+        )
+    }
+
+    #[test]
+    fn combinations_and_one_at_a_time_enumerate_their_variants() {
+        let all = spec(SweepMode::Combinations).unwrap().variants();
+        assert_eq!(all.len(), 6);
+        assert_eq!(all[0].name, "v0-esp.stagnation=20+problem.tasks.task3_speed=0.1");
+        assert_eq!(all[5].settings[1], ("problem.tasks.task3_speed".into(), "0.3".into()));
+        let one = spec(SweepMode::OneAtATime).unwrap().variants();
+        assert_eq!(one.len(), 6, "base, 2 stagnations, 3 speeds");
+        assert_eq!(one[0].name, "v0-base");
+        assert!(one[1..].iter().all(|v| v.settings.len() == 1));
+    }
+
+    #[test]
+    fn a_variant_sets_its_values_over_the_base_file() {
+        let mut s = spec(SweepMode::Combinations).unwrap();
+        s.grid.overrides = Some("[esp]\nsubpop_size = 20\n".into());
+        let variants = s.variants();
+        let grid = s.variant_grid(&variants[3]).unwrap();
+        let config = grid.run_config(crate::GridConfig::InputNoise).unwrap();
+        assert_eq!(config.esp.subpop_size, 20);
+        assert_eq!(config.esp.stagnation, 40);
+        assert_eq!(config.problem.tasks.task3_speed, 0.1);
+        assert_eq!(config.problem.noise.input_sd, crate::PAPER_NOISE_SD);
+    }
+
+    #[test]
+    fn every_reading_of_the_fitness_and_the_inputs_can_be_varied() {
+        use crate::psa::{FitnessKind, FitnessState, HeadingInput, HeadingWrap, Scoring, Task};
+        let vary = [
+            "problem.fitness.kind=incremental,original",
+            "problem.fitness.scoring=evolution,original",
+            "problem.fitness.state=truth,sensed",
+            "problem.sensors.heading_input=error,absolute",
+            "problem.sensors.heading_wrap=symmetric,positive",
+            "problem.noise.on_bias=false,true",
+            "problem.task3.fitness=original",
+            "problem.task3.scoring=incremental",
+            "problem.task2.steps=2000",
+        ];
+        let s = SweepSpec::new(
+            GridSpec::from_preset(GridPreset::Quick),
+            vary.iter().map(|v| parse_vary(v).unwrap()).collect(),
+            SweepMode::OneAtATime,
+        )
+        .unwrap();
+        // The base, then the second value of each two-valued setting and the single ones.
+        let problem = |i: usize| {
+            let variants = s.variants();
+            let grid = s.variant_grid(&variants[i]).unwrap();
+            grid.run_config(crate::GridConfig::Preset(
+                crate::Preset::Baseline,
+            ))
+            .unwrap()
+            .problem
+        };
+        let variants = s.variants();
+        let at = |setting: &str| {
+            let (key, value) = setting.split_once('=').unwrap();
+            variants
+                .iter()
+                .position(|v| {
+                    v.settings
+                        .first()
+                        .is_some_and(|(k, v)| k == key && v.trim_matches('"') == value)
+                })
+                .unwrap_or_else(|| panic!("no variant {setting}"))
+        };
+        assert_eq!(
+            problem(at("problem.fitness.kind=original")).fitness.kind,
+            FitnessKind::Original
+        );
+        assert_eq!(
+            problem(at("problem.fitness.scoring=original")).fitness.scoring,
+            Scoring::Original
+        );
+        assert_eq!(
+            problem(at("problem.fitness.state=sensed")).fitness.state,
+            FitnessState::Sensed
+        );
+        assert_eq!(
+            problem(at("problem.sensors.heading_input=absolute"))
+                .sensors
+                .heading_input,
+            HeadingInput::Absolute
+        );
+        assert_eq!(
+            problem(at("problem.sensors.heading_wrap=positive"))
+                .sensors
+                .heading_wrap,
+            HeadingWrap::Positive
+        );
+        assert!(problem(at("problem.noise.on_bias=true")).noise.on_bias);
+        let task3 = problem(at("problem.task3.fitness=original"));
+        assert_eq!(
+            task3.for_task(Task::StopAtPosition).unwrap().fitness.kind,
+            FitnessKind::Original
+        );
+        assert_eq!(
+            task3.for_task(Task::Turn).unwrap().fitness.kind,
+            FitnessKind::Incremental
+        );
+        assert!(problem(at("problem.task3.scoring=incremental")).task3.scoring == Some(Scoring::Incremental));
+        assert_eq!(
+            problem(at("problem.task2.steps=2000"))
+                .for_task(Task::Turn)
+                .unwrap()
+                .steps,
+            2000
+        );
+        assert_eq!(problem(0).fitness.state, FitnessState::default());
+    }
+
+    #[test]
+    fn a_bad_key_or_value_is_named_before_anything_runs() {
+        let grid = GridSpec::from_preset(GridPreset::Quick);
+        let e = SweepSpec::new(
+            grid.clone(),
+            vec![parse_vary("esp.stagnaton=20").unwrap()],
+            SweepMode::Combinations,
+        )
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("stagnaton"), "{e:#}");
+        let e = SweepSpec::new(
+            grid,
+            vec![parse_vary("esp.mutation_rate=0.5,2").unwrap()],
+            SweepMode::Combinations,
+        )
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("mutation_rate"), "{e:#}");
+    }
+}

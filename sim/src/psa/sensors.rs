@@ -1,0 +1,195 @@
+//! What the controller sees and how its outputs reach the thrusters
+//! (`docs/specification.md` §2): inputs relative to the target in the world frame,
+//! scaled, with Gaussian noise on inputs and outputs.
+
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use super::task::Target;
+use crate::numeric::{NoiseSource, Real};
+use crate::physics::{wrap_angle, BodyState};
+
+/// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
+pub const INPUT_COUNT: usize = 7;
+
+/// What the heading input measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingInput {
+    /// The heading minus the target heading. `[chosen]` default
+    #[default]
+    Error,
+    /// The heading itself (the paper says only x and y are relative to the target).
+    Absolute,
+}
+
+/// The range the heading input is wrapped to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum HeadingWrap {
+    /// (-pi, pi]. `[chosen]` default
+    #[default]
+    Symmetric,
+    /// [0, 2 pi).
+    Positive,
+}
+
+impl HeadingWrap {
+    /// `angle` (already wrapped to (-pi, pi]) in this range.
+    #[inline(always)]
+    pub fn apply<R: Real>(self, angle: R) -> R {
+        match self {
+            HeadingWrap::Symmetric => angle,
+            HeadingWrap::Positive => R::select(angle.lt(R::splat(0.0)), angle + R::splat(std::f64::consts::TAU), angle),
+        }
+    }
+}
+
+/// Input scaling (`[chosen]` values; the paper's inputs were O(1) or larger).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorSettings {
+    /// Input units per metre of position relative to the target. `[chosen]` 10
+    pub position_scale: f64,
+    /// Input units per m/s of velocity. `[chosen]` 10
+    pub velocity_scale: f64,
+    /// Input units per radian of heading error. `[chosen]` 1
+    pub heading_scale: f64,
+    /// Input units per rad/s of angular velocity. `[chosen]` 1
+    pub angular_velocity_scale: f64,
+    /// The constant bias input. `[chosen]` 1
+    pub bias: f64,
+    /// What the heading input measures. `[chosen]` error
+    pub heading_input: HeadingInput,
+    /// The range the heading input is wrapped to. `[chosen]` symmetric
+    pub heading_wrap: HeadingWrap,
+}
+
+impl Default for SensorSettings {
+    fn default() -> Self {
+        SensorSettings {
+            position_scale: 10.0,
+            velocity_scale: 10.0,
+            heading_scale: 1.0,
+            angular_velocity_scale: 1.0,
+            bias: 1.0,
+            heading_input: HeadingInput::Error,
+            heading_wrap: HeadingWrap::Symmetric,
+        }
+    }
+}
+
+impl SensorSettings {
+    /// The network inputs for `state` relative to `target`, without noise:
+    /// x, y, vx, vy, the heading input, omega, bias.
+    pub fn inputs(&self, state: &BodyState, target: &Target) -> [f64; INPUT_COUNT] {
+        let heading_error = wrap_angle(state.heading - target.heading);
+        self.inputs_from(
+            [state.x - target.x, state.y - target.y],
+            [state.vx, state.vy],
+            self.heading_reading(state.heading, heading_error),
+            state.omega,
+        )
+    }
+
+    /// The heading input's angle before scaling: the wrapped heading error
+    /// `heading_error` (the heading minus the target's, wrapped to (-pi,
+    /// pi]) or the wrapped `heading`, in the wrap range.
+    #[inline(always)]
+    pub fn heading_reading<R: Real>(&self, heading: R, heading_error: R) -> R {
+        let angle = match self.heading_input {
+            HeadingInput::Error => heading_error,
+            HeadingInput::Absolute => crate::numeric::wrap_angle(heading),
+        };
+        self.heading_wrap.apply(angle)
+    }
+
+    /// The inputs from the position relative to the target, the velocity,
+    /// the heading reading ([`SensorSettings::heading_reading`]) and omega:
+    /// the arithmetic every evaluation path shares.
+    #[inline(always)]
+    pub fn inputs_from<R: Real>(
+        &self,
+        offset: [R; 2],
+        velocity: [R; 2],
+        heading_reading: R,
+        omega: R,
+    ) -> [R; INPUT_COUNT] {
+        [
+            offset[0] * R::splat(self.position_scale),
+            offset[1] * R::splat(self.position_scale),
+            velocity[0] * R::splat(self.velocity_scale),
+            velocity[1] * R::splat(self.velocity_scale),
+            heading_reading * R::splat(self.heading_scale),
+            omega * R::splat(self.angular_velocity_scale),
+            R::splat(self.bias),
+        ]
+    }
+
+    /// Rejects values outside their [ranges](super::limits).
+    pub fn validate(&self) -> Result<(), String> {
+        super::limits::check_all(&[
+            ("sensors.position_scale", self.position_scale),
+            ("sensors.velocity_scale", self.velocity_scale),
+            ("sensors.heading_scale", self.heading_scale),
+            ("sensors.angular_velocity_scale", self.angular_velocity_scale),
+            ("sensors.bias", self.bias),
+        ])
+    }
+}
+
+/// Gaussian white noise on the network's inputs (the bias too, if
+/// `on_bias`) and outputs, drawn from a [`NoiseSource`] per trial.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseSettings {
+    /// Standard deviation of the noise on every input but the bias. `[paper]` 0 (0.05 in robustness tests)
+    pub input_sd: f64,
+    /// Standard deviation of the noise on every output, before clamping to [0, 1]. `[paper]` 0
+    pub output_sd: f64,
+    /// Whether the input noise reaches the bias unit too ("added to each
+    /// input neuron"; the bias is one of the seven input units). `[chosen]` false
+    pub on_bias: bool,
+}
+
+impl NoiseSettings {
+    /// Rejects deviations outside their [ranges](super::limits).
+    pub fn validate(&self) -> Result<(), String> {
+        super::limits::check_all(&[("noise.input_sd", self.input_sd), ("noise.output_sd", self.output_sd)])
+    }
+
+    /// Whether any noise is configured.
+    pub fn is_active(&self) -> bool {
+        self.input_sd > 0.0 || self.output_sd > 0.0
+    }
+
+    /// The seed of a trial's [`NoiseSource`]: one word drawn from `rng` when
+    /// noise is configured. Without noise nothing is drawn (the source then
+    /// goes unused), so noiseless runs consume their streams as before.
+    pub fn draw_seed(&self, rng: &mut impl Rng) -> u64 {
+        if self.is_active() {
+            rng.next_u64()
+        } else {
+            0
+        }
+    }
+
+    /// Adds input noise to every input but the last (the bias), or to
+    /// every one with `on_bias`.
+    #[inline(always)]
+    pub fn perturb_inputs<R: Real>(&self, inputs: &mut [R], source: &mut NoiseSource<R::Word>) {
+        if self.input_sd > 0.0 {
+            let n = if self.on_bias { inputs.len() } else { inputs.len() - 1 };
+            source.add_scaled(&mut inputs[..n], self.input_sd);
+        }
+    }
+
+    /// Adds output noise; the caller then clamps every output to [0, 1]
+    /// ([`clamp_unit`](crate::numeric::clamp_unit)).
+    #[inline(always)]
+    pub fn perturb_outputs<R: Real>(&self, outputs: &mut [R], source: &mut NoiseSource<R::Word>) {
+        if self.output_sd > 0.0 {
+            source.add_scaled(outputs, self.output_sd);
+        }
+    }
+}
