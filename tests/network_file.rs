@@ -80,6 +80,38 @@ fn files_from_before_the_exponential_setting_load_with_the_accurate_one() {
 }
 
 #[test]
+fn files_from_before_the_readings_of_the_fitness_load_scored_on_their_evolution_fitness_from_the_true_state() {
+    use psa_esp::psa::{FitnessState, Scoring};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("net.json");
+    let mut old = valid_json();
+    let fitness = old["problem"]["fitness"].as_object_mut().unwrap();
+    fitness.remove("scoring").unwrap();
+    fitness.remove("state").unwrap();
+    std::fs::write(&path, old.to_string()).unwrap();
+    let problem = NetworkFile::load(&path).unwrap().0.problem.unwrap();
+    assert_eq!(
+        (problem.fitness.scoring, problem.fitness.state),
+        (Scoring::Evolution, FitnessState::True)
+    );
+    // Today's files name them, and keep the defaults.
+    let new = valid_json();
+    assert_eq!(
+        (
+            new["problem"]["fitness"]["scoring"].as_str(),
+            new["problem"]["fitness"]["state"].as_str()
+        ),
+        (Some("original"), Some("sensed"))
+    );
+    std::fs::write(&path, new.to_string()).unwrap();
+    let problem = NetworkFile::load(&path).unwrap().0.problem.unwrap();
+    assert_eq!(
+        (problem.fitness.scoring, problem.fitness.state),
+        (Scoring::Original, FitnessState::Sensed)
+    );
+}
+
+#[test]
 fn malformed_files_are_rejected_with_the_file_and_the_problem() {
     let dir = tempfile::tempdir().unwrap();
     let mut cases: Vec<(&str, String, &str)> = vec![

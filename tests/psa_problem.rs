@@ -283,7 +283,7 @@ fn start_states_and_targets_are_as_specified() {
         (s1, g1),
         (
             BodyState {
-                omega: 2.0,
+                omega: 1.0,
                 ..BodyState::default()
             },
             Target::default()

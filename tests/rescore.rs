@@ -53,28 +53,32 @@ fn files_named(dir: &Path, name: &str) -> Vec<(String, Vec<u8>)> {
 #[test]
 fn rescoring_gives_the_robustness_results_of_a_grid_scored_that_way_from_the_start() {
     let tmp = tempfile::tempdir().unwrap();
-    let original = tmp.path().join("original.toml");
+    let (original, evolution) = (tmp.path().join("original.toml"), tmp.path().join("evolution.toml"));
     std::fs::write(&original, "[problem.fitness]\nscoring = \"original\"\n").unwrap();
+    std::fs::write(&evolution, "[problem.fitness]\nscoring = \"evolution\"\n").unwrap();
     let (grid, scored, rescored) = (
         tmp.path().join("grid"),
         tmp.path().join("scored"),
         tmp.path().join("rescored"),
     );
-    replicate(&grid, None);
+    replicate(&grid, Some(&evolution));
     replicate(&scored, Some(&original));
-    let out = psa_esp(&[
-        "rescore",
-        grid.to_str().unwrap(),
-        "--config",
-        original.to_str().unwrap(),
-        "--out",
-        rescored.to_str().unwrap(),
-    ]);
+    let rescore = || {
+        psa_esp(&[
+            "rescore",
+            grid.to_str().unwrap(),
+            "--config",
+            original.to_str().unwrap(),
+            "--out",
+            rescored.to_str().unwrap(),
+        ])
+    };
+    let out = rescore();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(String::from_utf8_lossy(&out.stdout).contains("8 re-scored now"));
-    // The evolution is the same in all three (the champion files of the
-    // grid scored from the start record its scoring); the tests of the
-    // re-scored grid are those of that grid.
+    // The evolution is the same in all three (the champion and
+    // configuration files of the grid scored from the start record its
+    // scoring); the tests of the re-scored grid are those of that grid.
     for name in ["records.csv", "champion.json", "config.toml"] {
         assert!(
             files_named(&grid, name) == files_named(&rescored, name),
@@ -89,14 +93,7 @@ fn rescoring_gives_the_robustness_results_of_a_grid_scored_that_way_from_the_sta
     assert!(String::from_utf8_lossy(&tests[0].1).contains("\"rescored\": true"));
 
     // Run again: nothing left to do, nothing changed.
-    let again = psa_esp(&[
-        "rescore",
-        grid.to_str().unwrap(),
-        "--config",
-        original.to_str().unwrap(),
-        "--out",
-        rescored.to_str().unwrap(),
-    ]);
+    let again = rescore();
     assert!(String::from_utf8_lossy(&again.stdout).contains("8 already re-scored, 0 re-scored now"));
     assert!(files_named(&rescored, "robustness.json") == tests);
 

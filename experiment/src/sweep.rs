@@ -471,11 +471,9 @@ mod tests {
         let problem = |i: usize| {
             let variants = s.variants();
             let grid = s.variant_grid(&variants[i]).unwrap();
-            grid.run_config(crate::GridConfig::Preset(
-                crate::Preset::Baseline,
-            ))
-            .unwrap()
-            .problem
+            grid.run_config(crate::GridConfig::Preset(crate::Preset::Baseline))
+                .unwrap()
+                .problem
         };
         let variants = s.variants();
         let at = |setting: &str| {

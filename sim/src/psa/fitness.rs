@@ -29,12 +29,13 @@ pub enum SlowingRule {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum Scoring {
-    /// The evolution fitness itself. `[chosen]` default
-    #[default]
+    /// The evolution fitness itself.
     Evolution,
     /// Høverstad's incremental fitness, whatever evolution used.
     Incremental,
-    /// Sit's original fitness, whatever evolution used.
+    /// Sit's original fitness, whatever evolution used. `[fitted]` default
+    /// (docs/model.md, sweeps S12-S15)
+    #[default]
     Original,
 }
 
@@ -55,11 +56,12 @@ impl Scoring {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum FitnessState {
-    /// The true position, heading and spin (`"truth"`). `[chosen]` default
-    #[default]
+    /// The true position, heading and spin (`"truth"`).
     #[serde(rename = "truth", alias = "true")]
     True,
     /// The sensed ones: under input noise the fitness sees the noise too.
+    /// `[fitted]` default (docs/model.md, sweep S12)
+    #[default]
     Sensed,
 }
 
@@ -82,9 +84,9 @@ pub struct FitnessSettings {
     /// Extra points for also being on heading. `[paper]` 3
     pub heading_points: f64,
     /// What champions are scored with (Tables 1-7; per task with
-    /// `problem.taskN.scoring`). `[chosen]` evolution
+    /// `problem.taskN.scoring`). `[fitted]` original
     pub scoring: Scoring,
-    /// Which state the fitness reads: `truth` or `sensed`. `[chosen]` truth
+    /// Which state the fitness reads: `truth` or `sensed`. `[fitted]` sensed
     pub state: FitnessState,
 }
 
@@ -98,8 +100,8 @@ impl Default for FitnessSettings {
             slowing: SlowingRule::Magnitude,
             position_points: 1.0,
             heading_points: 3.0,
-            scoring: Scoring::Evolution,
-            state: FitnessState::True,
+            scoring: Scoring::Original,
+            state: FitnessState::Sensed,
         }
     }
 }

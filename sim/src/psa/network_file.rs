@@ -195,6 +195,17 @@ impl NetworkFile {
             problem
                 .entry("exponential")
                 .or_insert_with(|| serde_json::json!(Exponential::Accurate));
+            // Likewise, files from before the readings of the fitness were
+            // settings were scored on the fitness they were evolved on,
+            // read from the true state.
+            if let Some(fitness) = problem.get_mut("fitness").and_then(|f| f.as_object_mut()) {
+                fitness
+                    .entry("scoring")
+                    .or_insert_with(|| serde_json::json!(crate::psa::Scoring::Evolution));
+                fitness
+                    .entry("state")
+                    .or_insert_with(|| serde_json::json!(crate::psa::FitnessState::True));
+            }
         }
         let file: NetworkFile = serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;
         if file.activation != ACTIVATION {

@@ -153,6 +153,7 @@ mod tests {
     #[test]
     fn the_sensed_fitness_reads_the_inputs_over_their_scales() {
         let mut s = PsaSettings::default();
+        s.fitness.state = FitnessState::True;
         let target = [0.0, 0.0, 0.0];
         let before = clean_reading(&s, 0.0, target);
         // Truly on heading, in the box and spinning slower than before.

@@ -95,8 +95,9 @@ pub struct Target {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TaskSettings {
-    /// Task 1: initial spin (rad/s). `[fitted]` 2.0: the paper's Table 1
-    /// level for task 1 (docs/model.md, sweep S10)
+    /// Task 1: initial spin (rad/s). `[fitted]` 1.0: the paper's Table 1
+    /// and 2 levels for task 1 with champions scored on the original
+    /// fitness (docs/model.md, sweeps S10 and S14)
     pub task1_spin: f64,
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
@@ -120,7 +121,7 @@ pub struct TaskSettings {
 impl Default for TaskSettings {
     fn default() -> Self {
         TaskSettings {
-            task1_spin: 2.0,
+            task1_spin: 1.0,
             task2_target_heading: FRAC_PI_2,
             task2_spin: 1.25,
             task2_velocity: [0.0, 0.0],
