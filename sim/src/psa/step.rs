@@ -184,11 +184,13 @@ mod tests {
 
     #[test]
     fn a_task_flies_its_own_steps_and_fitness_and_is_scored_with_its_scoring() {
-        let mut s = PsaSettings::default();
-        s.task3 = TaskOverrides {
-            steps: Some(2000),
-            fitness: Some(FitnessKind::Original),
-            scoring: None,
+        let mut s = PsaSettings {
+            task3: TaskOverrides {
+                steps: Some(2000),
+                fitness: Some(FitnessKind::Original),
+                scoring: None,
+            },
+            ..PsaSettings::default()
         };
         s.fitness.scoring = Scoring::Original;
         let task3 = s.for_task(Task::StopAtPosition).unwrap();
