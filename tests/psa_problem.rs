@@ -395,3 +395,45 @@ fn inputs_are_relative_to_the_target_scaled_and_wrapped() {
     assert!((i[4] - (PI - 3.0)).abs() < 1e-12, "{}", i[4]);
     assert_eq!((i[5], i[6]), (0.7, 1.0));
 }
+
+mod per_task {
+    use psa_esp::psa::{FitnessKind, Scoring, Task, TaskOverrides, TrialRunner};
+
+    #[test]
+    fn a_task_flies_its_own_steps_and_fitness_and_is_scored_with_its_scoring() {
+        let mut s = psa_esp::psa::PsaSettings {
+            task3: TaskOverrides {
+                steps: Some(2000),
+                fitness: Some(FitnessKind::Original),
+                scoring: None,
+            },
+            ..psa_esp::psa::PsaSettings::default()
+        };
+        s.fitness.scoring = Scoring::Original;
+        let task3 = s.for_task(Task::StopAtPosition).unwrap();
+        assert_eq!((task3.steps, task3.fitness.kind), (2000, FitnessKind::Original));
+        assert!(task3.task3.is_empty());
+        assert_eq!(
+            TrialRunner::new(&s, Task::StopAtPosition).unwrap().maximum_points(),
+            2000.0
+        );
+        assert_eq!(TrialRunner::new(&s, Task::Turn).unwrap().maximum_points(), 2000.0);
+        let task1 = s.for_task(Task::StopRotation).unwrap();
+        assert_eq!((task1.steps, task1.fitness.kind), (500, FitnessKind::Incremental));
+        // Scored on the original fitness: task 1 apart, task 3 already evolved on it.
+        assert!(s.rescored(Task::StopRotation) && !s.rescored(Task::StopAtPosition));
+        assert_eq!(
+            s.scoring_for(Task::StopRotation).unwrap().fitness.kind,
+            FitnessKind::Original
+        );
+        s.task1.scoring = Some(Scoring::Evolution);
+        assert!(!s.rescored(Task::StopRotation));
+        assert_eq!(
+            s.scoring_for(Task::StopRotation).unwrap().fitness.kind,
+            FitnessKind::Incremental
+        );
+        s.task2.steps = Some(0);
+        let error = s.validate().unwrap_err().to_string();
+        assert!(error.contains("task2.steps = 0"), "{error}");
+    }
+}

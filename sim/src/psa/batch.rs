@@ -132,7 +132,8 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     let mut points = zero;
     let read = |state: &PlanarState<V<N>>, noise: &mut NoiseSource<Words<N>>| {
         sense::<V<N>, NOISY>(
-            s,
+            &s.sensors,
+            &s.noise,
             state.position,
             state.velocity,
             state.heading(),
@@ -194,7 +195,17 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
         let previous_omega = state.omega;
         flight.body.step(state, &outputs);
         let next = read(state, noise);
-        points = points + score(s, &next, &reading, state.position, state.omega, previous_omega, *target);
+        points = points
+            + score(
+                &s.fitness,
+                &s.sensors,
+                &next,
+                &reading,
+                state.position,
+                state.omega,
+                previous_omega,
+                *target,
+            );
         reading = next;
     }
     let finite = |v: V<N>| v.abs().le(V::<N>::splat(f64::MAX));

@@ -152,7 +152,8 @@ impl<'n> Lane<'n> {
     fn read<const NOISY: bool>(&mut self, s: &PsaSettings) -> Reading<f64> {
         let state = &self.state;
         sense::<f64, NOISY>(
-            s,
+            &s.sensors,
+            &s.noise,
             state.position,
             state.velocity,
             state.heading(),
@@ -207,7 +208,8 @@ fn fly_steps<const NOISY: bool>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &m
             let next = lane.read::<NOISY>(s);
             let state = &lane.state;
             lane.points += score(
-                s,
+                &s.fitness,
+                &s.sensors,
                 &next,
                 &lane.reading,
                 state.position,

@@ -4,9 +4,10 @@
 //! to it earns, read from the true state or the sensed one
 //! ([`FitnessState`]).
 
+use super::fitness::FitnessSettings;
 use super::fitness::{FitnessState, StepError};
 use super::sensors::INPUT_COUNT;
-use super::trial::PsaSettings;
+use super::sensors::{NoiseSettings, SensorSettings};
 use crate::numeric::{wrap_angle, NoiseSource, Real};
 
 /// One state as the controller reads it, and its true error against the target.
@@ -23,7 +24,8 @@ pub struct Reading<R> {
 /// when `NOISY`.
 #[inline(always)]
 pub fn sense<R: Real, const NOISY: bool>(
-    s: &PsaSettings,
+    sensors: &SensorSettings,
+    noise_settings: &NoiseSettings,
     position: [R; 2],
     velocity: [R; 2],
     heading: R,
@@ -33,14 +35,9 @@ pub fn sense<R: Real, const NOISY: bool>(
 ) -> Reading<R> {
     let heading_error = wrap_angle(heading - target[2]);
     let offset = [position[0] - target[0], position[1] - target[1]];
-    let mut inputs = s.sensors.inputs_from(
-        offset,
-        velocity,
-        s.sensors.heading_reading(heading, heading_error),
-        omega,
-    );
+    let mut inputs = sensors.inputs_from(offset, velocity, sensors.heading_reading(heading, heading_error), omega);
     if NOISY {
-        s.noise.perturb_inputs(&mut inputs, noise);
+        noise_settings.perturb_inputs(&mut inputs, noise);
     }
     Reading { inputs, heading_error }
 }
@@ -50,7 +47,8 @@ pub fn sense<R: Real, const NOISY: bool>(
 /// `previous_omega`), against `target`.
 #[inline(always)]
 pub fn score<R: Real>(
-    s: &PsaSettings,
+    fitness: &FitnessSettings,
+    sensors: &SensorSettings,
     now: &Reading<R>,
     before: &Reading<R>,
     position: [R; 2],
@@ -58,7 +56,7 @@ pub fn score<R: Real>(
     previous_omega: R,
     target: [R; 3],
 ) -> R {
-    let error = match s.fitness.state {
+    let error = match fitness.state {
         FitnessState::True => StepError {
             x: position[0] - target[0],
             y: position[1] - target[1],
@@ -66,17 +64,21 @@ pub fn score<R: Real>(
             omega,
             previous_omega,
         },
-        FitnessState::Sensed => sensed_error(s, now, before, target[2]),
+        FitnessState::Sensed => sensed_error(sensors, now, before, target[2]),
     };
-    s.fitness.points(&error)
+    fitness.points(&error)
 }
 
 /// The error the sensors read: each input divided by its scale, the
 /// heading turned into an error against `target_heading` and wrapped to
 /// (-pi, pi].
 #[inline(always)]
-fn sensed_error<R: Real>(s: &PsaSettings, now: &Reading<R>, before: &Reading<R>, target_heading: R) -> StepError<R> {
-    let sensors = &s.sensors;
+fn sensed_error<R: Real>(
+    sensors: &SensorSettings,
+    now: &Reading<R>,
+    before: &Reading<R>,
+    target_heading: R,
+) -> StepError<R> {
     let heading = now.inputs[4] / R::splat(sensors.heading_scale);
     let heading = match sensors.heading_input {
         super::sensors::HeadingInput::Error => wrap_angle(heading),
@@ -97,13 +99,20 @@ mod tests {
     use std::f64::consts::{PI, TAU};
 
     use super::*;
-    use crate::psa::fitness::{FitnessKind, Scoring};
     use crate::psa::sensors::{HeadingInput, HeadingWrap};
-    use crate::psa::{Task, TaskOverrides, TrialRunner};
 
-    fn clean_reading(s: &PsaSettings, heading: f64, target: [f64; 3]) -> Reading<f64> {
+    /// The settings a step reads, at their defaults.
+    #[derive(Default)]
+    struct Settings {
+        sensors: SensorSettings,
+        noise: NoiseSettings,
+        fitness: FitnessSettings,
+    }
+
+    fn clean_reading(s: &Settings, heading: f64, target: [f64; 3]) -> Reading<f64> {
         sense::<f64, false>(
-            s,
+            &s.sensors,
+            &s.noise,
             [0.01, -0.02],
             [0.1, 0.0],
             heading,
@@ -115,7 +124,7 @@ mod tests {
 
     #[test]
     fn the_heading_input_is_the_error_or_the_heading_in_its_wrap_range() {
-        let mut s = PsaSettings::default();
+        let mut s = Settings::default();
         let target = [0.0, 0.0, 1.0];
         // The error: heading -3 against target 1 is -4, wrapped to 2 pi - 4.
         assert_eq!(clean_reading(&s, -3.0, target).inputs[4], TAU - 4.0);
@@ -135,10 +144,20 @@ mod tests {
 
     #[test]
     fn input_noise_reaches_the_bias_only_when_asked() {
-        let mut s = PsaSettings::default();
+        let mut s = Settings::default();
         s.noise.input_sd = 0.05;
-        let read = |s: &PsaSettings| {
-            sense::<f64, true>(s, [0.0; 2], [0.0; 2], 0.0, 0.0, [0.0; 3], &mut NoiseSource::new(7)).inputs
+        let read = |s: &Settings| {
+            sense::<f64, true>(
+                &s.sensors,
+                &s.noise,
+                [0.0; 2],
+                [0.0; 2],
+                0.0,
+                0.0,
+                [0.0; 3],
+                &mut NoiseSource::new(7),
+            )
+            .inputs
         };
         let without = read(&s);
         assert_eq!(without[6], s.sensors.bias);
@@ -152,71 +171,48 @@ mod tests {
 
     #[test]
     fn the_sensed_fitness_reads_the_inputs_over_their_scales() {
-        let mut s = PsaSettings::default();
+        let mut s = Settings::default();
         s.fitness.state = FitnessState::True;
         let target = [0.0, 0.0, 0.0];
         let before = clean_reading(&s, 0.0, target);
         // Truly on heading, in the box and spinning slower than before.
         let mut now = clean_reading(&s, 0.0, target);
         now.inputs[5] = 0.4;
-        let truth = score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target);
+        let truth = score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target);
         assert_eq!(truth, 4.0);
         // The sensors read 0.1 rad off heading and a spin of 0.6: under
         // the true reading nothing changes.
         now.inputs[4] = 0.1;
         now.inputs[5] = 0.6;
-        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 4.0);
+        assert_eq!(
+            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
+            4.0
+        );
         s.fitness.state = FitnessState::Sensed;
         // Sensed: off heading, and the spin (0.6 against 0.5 read before) rises.
-        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 0.0);
+        assert_eq!(
+            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
+            0.0
+        );
         now.inputs[5] = 0.3;
-        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 1.0);
+        assert_eq!(
+            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
+            1.0
+        );
         // Position: 10 input units a metre, so 2.5 reads 0.25 m, out of the box.
         now.inputs[0] = 2.5;
-        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 0.0);
+        assert_eq!(
+            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
+            0.0
+        );
         // An absolute heading input is read against the target heading.
         s.sensors.heading_input = HeadingInput::Absolute;
         let target = [0.0, 0.0, 3.0];
         now.inputs[0] = 0.1;
         now.inputs[4] = 3.01;
-        assert_eq!(score(&s, &now, &before, [0.01, -0.02], 0.4, 0.5, target), 4.0);
-    }
-
-    #[test]
-    fn a_task_flies_its_own_steps_and_fitness_and_is_scored_with_its_scoring() {
-        let mut s = PsaSettings {
-            task3: TaskOverrides {
-                steps: Some(2000),
-                fitness: Some(FitnessKind::Original),
-                scoring: None,
-            },
-            ..PsaSettings::default()
-        };
-        s.fitness.scoring = Scoring::Original;
-        let task3 = s.for_task(Task::StopAtPosition).unwrap();
-        assert_eq!((task3.steps, task3.fitness.kind), (2000, FitnessKind::Original));
-        assert!(task3.task3.is_empty());
         assert_eq!(
-            TrialRunner::new(&s, Task::StopAtPosition).unwrap().maximum_points(),
-            2000.0
+            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
+            4.0
         );
-        assert_eq!(TrialRunner::new(&s, Task::Turn).unwrap().maximum_points(), 2000.0);
-        let task1 = s.for_task(Task::StopRotation).unwrap();
-        assert_eq!((task1.steps, task1.fitness.kind), (500, FitnessKind::Incremental));
-        // Scored on the original fitness: task 1 apart, task 3 already evolved on it.
-        assert!(s.rescored(Task::StopRotation) && !s.rescored(Task::StopAtPosition));
-        assert_eq!(
-            s.scoring_for(Task::StopRotation).unwrap().fitness.kind,
-            FitnessKind::Original
-        );
-        s.task1.scoring = Some(Scoring::Evolution);
-        assert!(!s.rescored(Task::StopRotation));
-        assert_eq!(
-            s.scoring_for(Task::StopRotation).unwrap().fitness.kind,
-            FitnessKind::Incremental
-        );
-        s.task2.steps = Some(0);
-        let error = s.validate().unwrap_err().to_string();
-        assert!(error.contains("task2.steps = 0"), "{error}");
     }
 }

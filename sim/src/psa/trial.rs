@@ -401,7 +401,8 @@ fn fly_steps<const NOISY: bool>(
     let target = [target.x, target.y, target.heading];
     let read = |state: &crate::physics::PlanarState<f64>, noise: &mut NoiseSource<u64>| {
         sense::<f64, NOISY>(
-            s,
+            &s.sensors,
+            &s.noise,
             state.position,
             state.velocity,
             state.heading(),
@@ -424,7 +425,16 @@ fn fly_steps<const NOISY: bool>(
         let previous_omega = state.omega;
         state = backend.planar_state();
         let next = read(&state, noise);
-        let step_points = score(s, &next, &reading, state.position, state.omega, previous_omega, target);
+        let step_points = score(
+            &s.fitness,
+            &s.sensors,
+            &next,
+            &reading,
+            state.position,
+            state.omega,
+            previous_omega,
+            target,
+        );
         reading = next;
         points += step_points;
         if let Some(r) = record.as_deref_mut() {
