@@ -132,8 +132,7 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     let mut points = zero;
     let read = |state: &PlanarState<V<N>>, noise: &mut NoiseSource<Words<N>>| {
         sense::<V<N>, NOISY>(
-            &s.sensors,
-            &s.noise,
+            s.step(),
             state.position,
             state.velocity,
             state.heading(),
@@ -197,8 +196,7 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
         let next = read(state, noise);
         points = points
             + score(
-                &s.fitness,
-                &s.sensors,
+                s.step(),
                 &next,
                 &reading,
                 state.position,

@@ -152,8 +152,7 @@ impl<'n> Lane<'n> {
     fn read<const NOISY: bool>(&mut self, s: &PsaSettings) -> Reading<f64> {
         let state = &self.state;
         sense::<f64, NOISY>(
-            &s.sensors,
-            &s.noise,
+            s.step(),
             state.position,
             state.velocity,
             state.heading(),
@@ -208,8 +207,7 @@ fn fly_steps<const NOISY: bool>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &m
             let next = lane.read::<NOISY>(s);
             let state = &lane.state;
             lane.points += score(
-                &s.fitness,
-                &s.sensors,
+                s.step(),
                 &next,
                 &lane.reading,
                 state.position,

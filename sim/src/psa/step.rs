@@ -10,6 +10,18 @@ use super::sensors::INPUT_COUNT;
 use super::sensors::{NoiseSettings, SensorSettings};
 use crate::numeric::{wrap_angle, NoiseSource, Real};
 
+/// The settings one step reads: how the sensors read and are perturbed,
+/// and how the step is scored.
+#[derive(Debug, Clone, Copy)]
+pub struct StepSettings<'a> {
+    /// Input scaling and the heading input.
+    pub sensors: &'a SensorSettings,
+    /// Input noise (the output noise is the caller's).
+    pub noise: &'a NoiseSettings,
+    /// The fitness and the state it reads.
+    pub fitness: &'a FitnessSettings,
+}
+
 /// One state as the controller reads it, and its true error against the target.
 #[derive(Debug, Clone, Copy)]
 pub struct Reading<R> {
@@ -24,8 +36,7 @@ pub struct Reading<R> {
 /// when `NOISY`.
 #[inline(always)]
 pub fn sense<R: Real, const NOISY: bool>(
-    sensors: &SensorSettings,
-    noise_settings: &NoiseSettings,
+    settings: StepSettings<'_>,
     position: [R; 2],
     velocity: [R; 2],
     heading: R,
@@ -35,9 +46,10 @@ pub fn sense<R: Real, const NOISY: bool>(
 ) -> Reading<R> {
     let heading_error = wrap_angle(heading - target[2]);
     let offset = [position[0] - target[0], position[1] - target[1]];
+    let sensors = settings.sensors;
     let mut inputs = sensors.inputs_from(offset, velocity, sensors.heading_reading(heading, heading_error), omega);
     if NOISY {
-        noise_settings.perturb_inputs(&mut inputs, noise);
+        settings.noise.perturb_inputs(&mut inputs, noise);
     }
     Reading { inputs, heading_error }
 }
@@ -47,8 +59,7 @@ pub fn sense<R: Real, const NOISY: bool>(
 /// `previous_omega`), against `target`.
 #[inline(always)]
 pub fn score<R: Real>(
-    fitness: &FitnessSettings,
-    sensors: &SensorSettings,
+    settings: StepSettings<'_>,
     now: &Reading<R>,
     before: &Reading<R>,
     position: [R; 2],
@@ -56,7 +67,7 @@ pub fn score<R: Real>(
     previous_omega: R,
     target: [R; 3],
 ) -> R {
-    let error = match fitness.state {
+    let error = match settings.fitness.state {
         FitnessState::True => StepError {
             x: position[0] - target[0],
             y: position[1] - target[1],
@@ -64,9 +75,9 @@ pub fn score<R: Real>(
             omega,
             previous_omega,
         },
-        FitnessState::Sensed => sensed_error(sensors, now, before, target[2]),
+        FitnessState::Sensed => sensed_error(settings.sensors, now, before, target[2]),
     };
-    fitness.points(&error)
+    settings.fitness.points(&error)
 }
 
 /// The error the sensors read: each input divided by its scale, the
@@ -109,10 +120,19 @@ mod tests {
         fitness: FitnessSettings,
     }
 
+    impl Settings {
+        fn step(&self) -> StepSettings<'_> {
+            StepSettings {
+                sensors: &self.sensors,
+                noise: &self.noise,
+                fitness: &self.fitness,
+            }
+        }
+    }
+
     fn clean_reading(s: &Settings, heading: f64, target: [f64; 3]) -> Reading<f64> {
         sense::<f64, false>(
-            &s.sensors,
-            &s.noise,
+            s.step(),
             [0.01, -0.02],
             [0.1, 0.0],
             heading,
@@ -148,8 +168,7 @@ mod tests {
         s.noise.input_sd = 0.05;
         let read = |s: &Settings| {
             sense::<f64, true>(
-                &s.sensors,
-                &s.noise,
+                s.step(),
                 [0.0; 2],
                 [0.0; 2],
                 0.0,
@@ -178,41 +197,26 @@ mod tests {
         // Truly on heading, in the box and spinning slower than before.
         let mut now = clean_reading(&s, 0.0, target);
         now.inputs[5] = 0.4;
-        let truth = score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target);
+        let truth = score(s.step(), &now, &before, [0.01, -0.02], 0.4, 0.5, target);
         assert_eq!(truth, 4.0);
         // The sensors read 0.1 rad off heading and a spin of 0.6: under
         // the true reading nothing changes.
         now.inputs[4] = 0.1;
         now.inputs[5] = 0.6;
-        assert_eq!(
-            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
-            4.0
-        );
+        assert_eq!(score(s.step(), &now, &before, [0.01, -0.02], 0.4, 0.5, target), 4.0);
         s.fitness.state = FitnessState::Sensed;
         // Sensed: off heading, and the spin (0.6 against 0.5 read before) rises.
-        assert_eq!(
-            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
-            0.0
-        );
+        assert_eq!(score(s.step(), &now, &before, [0.01, -0.02], 0.4, 0.5, target), 0.0);
         now.inputs[5] = 0.3;
-        assert_eq!(
-            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
-            1.0
-        );
+        assert_eq!(score(s.step(), &now, &before, [0.01, -0.02], 0.4, 0.5, target), 1.0);
         // Position: 10 input units a metre, so 2.5 reads 0.25 m, out of the box.
         now.inputs[0] = 2.5;
-        assert_eq!(
-            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
-            0.0
-        );
+        assert_eq!(score(s.step(), &now, &before, [0.01, -0.02], 0.4, 0.5, target), 0.0);
         // An absolute heading input is read against the target heading.
         s.sensors.heading_input = HeadingInput::Absolute;
         let target = [0.0, 0.0, 3.0];
         now.inputs[0] = 0.1;
         now.inputs[4] = 3.01;
-        assert_eq!(
-            score(&s.fitness, &s.sensors, &now, &before, [0.01, -0.02], 0.4, 0.5, target),
-            4.0
-        );
+        assert_eq!(score(s.step(), &now, &before, [0.01, -0.02], 0.4, 0.5, target), 4.0);
     }
 }

@@ -162,6 +162,15 @@ impl PsaSettings {
         Ok(())
     }
 
+    /// The settings one control step reads ([`super::step`]).
+    pub fn step(&self) -> super::step::StepSettings<'_> {
+        super::step::StepSettings {
+            sensors: &self.sensors,
+            noise: &self.noise,
+            fitness: &self.fitness,
+        }
+    }
+
     /// The overrides of `task`.
     pub fn overrides(&self, task: Task) -> &TaskOverrides {
         match task {
@@ -401,8 +410,7 @@ fn fly_steps<const NOISY: bool>(
     let target = [target.x, target.y, target.heading];
     let read = |state: &crate::physics::PlanarState<f64>, noise: &mut NoiseSource<u64>| {
         sense::<f64, NOISY>(
-            &s.sensors,
-            &s.noise,
+            s.step(),
             state.position,
             state.velocity,
             state.heading(),
@@ -426,8 +434,7 @@ fn fly_steps<const NOISY: bool>(
         state = backend.planar_state();
         let next = read(&state, noise);
         let step_points = score(
-            &s.fitness,
-            &s.sensors,
+            s.step(),
             &next,
             &reading,
             state.position,
