@@ -338,3 +338,69 @@ pub fn write_sweep_report(dir: &Path) -> Result<(SweepReport, String, Vec<PathBu
     crate::io::write_atomic(&runs_path, sweep_runs_csv(&keys, &variants)?.as_bytes())?;
     Ok((report, markdown, vec![md_path, json_path, runs_path]))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn variant(settings: &[(&str, &str)], verdicts: &[Verdict]) -> VariantSummary {
+        VariantSummary {
+            name: format!("{settings:?}"),
+            settings: settings.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
+            runs: (0, 0),
+            table1: [f64::NAN; 3],
+            bursts_per_run: [f64::NAN; 2],
+            noise_ratio: f64::NAN,
+            random_init_ratio: f64::NAN,
+            findings: verdicts
+                .iter()
+                .enumerate()
+                .map(|(i, v)| (format!("finding {i}"), *v))
+                .collect(),
+            distance: Distance {
+                total: 0.0,
+                terms: Vec::new(),
+                missing: Vec::new(),
+            },
+        }
+    }
+
+    #[test]
+    fn a_categorical_reading_flips_the_findings_it_alone_changes() {
+        use Verdict::*;
+        // One at a time: the base, then each reading alone.
+        let variants = [
+            variant(&[], &[Reproduced, NotReproduced, NotTestable]),
+            variant(
+                &[("problem.fitness.scoring", "\"evolution\"")],
+                &[NotReproduced, NotReproduced, Reproduced],
+            ),
+            variant(
+                &[("problem.sensors.heading_input", "\"absolute\"")],
+                &[Reproduced, Reproduced, NotReproduced],
+            ),
+        ];
+        // A finding not testable on one side does not flip.
+        assert_eq!(flips(&variants, "problem.fitness.scoring"), ["finding 0"]);
+        assert_eq!(flips(&variants, "problem.sensors.heading_input"), ["finding 1"]);
+        // In combinations, two variants that differ in another reading too are not compared.
+        let combined = [
+            variant(
+                &[
+                    ("problem.fitness.scoring", "\"original\""),
+                    ("problem.fitness.state", "\"truth\""),
+                ],
+                &[Reproduced],
+            ),
+            variant(
+                &[
+                    ("problem.fitness.scoring", "\"evolution\""),
+                    ("problem.fitness.state", "\"sensed\""),
+                ],
+                &[NotReproduced],
+            ),
+        ];
+        assert!(flips(&combined, "problem.fitness.scoring").is_empty());
+        assert!(flips(&combined, "problem.fitness.state").is_empty());
+    }
+}
