@@ -352,3 +352,96 @@ fn a_tiny_grid_reports_every_table_and_figure() {
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(md.contains("PARTIAL GRID") && md.contains("hill-climb"), "{md}");
 }
+
+/// A folder's files as [`run_files`] gives them: (relative path, bytes).
+type Files = Vec<(String, Vec<u8>)>;
+
+/// Every file of every run of every variant of the sweep in `dir`, by variant.
+fn sweep_files(dir: &Path) -> Vec<(String, Files)> {
+    let mut variants: Vec<_> = std::fs::read_dir(dir.join("variants"))
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .collect();
+    variants.sort();
+    variants
+        .iter()
+        .map(|v| (v.file_name().unwrap().to_string_lossy().into_owned(), run_files(v)))
+        .collect()
+}
+
+#[test]
+fn a_sweep_in_lockstep_advances_every_variant_in_one_pass_to_the_files_of_run_by_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (apart, together) = (tmp.path().join("apart"), tmp.path().join("together"));
+    let args = |out: &Path, lockstep: bool| -> Vec<String> {
+        let mut args: Vec<String> = [
+            "sweep",
+            "--vary",
+            "esp.stagnation=5,10",
+            "--configs",
+            "baseline",
+            "--tasks",
+            "1",
+            "--seeds",
+            "2",
+            "--generations",
+            "150",
+            "--robustness-trials",
+            "5",
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .map(String::from)
+        .to_vec();
+        if lockstep {
+            args.extend(["--lockstep", "--threads", "2"].map(String::from));
+        } else {
+            args.extend(["--jobs", "1"].map(String::from));
+        }
+        args
+    };
+    let o = psa_esp(&args(&apart, false).iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    // In one pass every run of both variants holds a checkpoint at once
+    // (variant after variant, the second would start only once the first's
+    // runs had ended and dropped theirs): kill -9 the sweep then.
+    let mut child = Command::new(common::binary())
+        .args(args(&together, true))
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let checkpoints = |dir: &Path| -> usize {
+        let Ok(variants) = std::fs::read_dir(dir.join("variants")) else {
+            return 0;
+        };
+        variants
+            .map(|v| v.unwrap().path())
+            .filter(|v| v.join("runs").exists())
+            .flat_map(|v| run_file_paths(&v))
+            .filter(|p| p.ends_with("checkpoint.json"))
+            .count()
+    };
+    while checkpoints(&together) < 4 {
+        assert!(
+            Instant::now() < deadline,
+            "not every variant's runs held a checkpoint in time"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+
+    // Resumed, the sweep's files are those of the run-by-run sweep.
+    let o = psa_esp(&args(&together, true).iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let files = sweep_files(&apart);
+    assert_eq!(files.len(), 2);
+    assert!(files
+        .iter()
+        .all(|(_, runs)| runs.iter().filter(|(p, _)| p.ends_with("robustness.json")).count() == 2));
+    assert!(
+        files == sweep_files(&together),
+        "the lockstep sweep differs from the run-by-run one"
+    );
+}

@@ -1,7 +1,7 @@
-//! The lockstep grid executor: every run of a grid (or of what is left of
-//! it) advanced together, one round per generation, each round's networks
-//! of all runs evaluated in one batch (the search crate's
-//! [`lockstep_with`]).
+//! The lockstep grid executor: every run of a grid, or of several grids
+//! (a sweep's variants), or of what is left of them, advanced together,
+//! one round per generation, each round's networks of all runs evaluated
+//! in one batch (the search crate's [`lockstep_with`]).
 //! Each run is the run it is on its own, bit for bit: its files are
 //! byte-identical to those of the run-by-run executor (run.json's times
 //! aside). Every `CHECKPOINT_ROUNDS` rounds each unfinished run saves its
@@ -16,6 +16,7 @@ use rayon::prelude::*;
 
 use super::grid::{run_dir, GridSpec, RunKey};
 use super::grid_run::{run_seed, test_and_mark, FinishedRun};
+use super::replicate::GridJob;
 use super::{Algorithm, GridConfig, RunConfig, RunStart};
 use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::lockstep::lockstep_with;
@@ -47,6 +48,8 @@ pub enum Executor {
 
 /// A run started on disk, ready to be driven.
 struct Started {
+    /// Its grid's index.
+    grid: usize,
     key: RunKey,
     config: RunConfig,
     seed: u64,
@@ -55,31 +58,37 @@ struct Started {
     evaluator: usize,
 }
 
-/// Runs `todo` of `spec` in `dir` in lockstep on the current rayon pool,
-/// their networks evaluated on `path`, handing each run's outcome to
-/// `finished` as [`crate::grid_run::run_one`] would give it.
+/// An evaluator of one grid's configuration and task.
+type CellEvaluator = ((usize, GridConfig, Task), PsaEvaluator);
+
+/// Runs `todo` (each a run of one of `grids`, by index) in lockstep on the
+/// current rayon pool, their networks evaluated on `path`: every grid's
+/// runs in one pass. Hands each run's outcome to `finished` with its
+/// grid's index, as [`crate::grid_run::run_one`] would give it.
 pub(super) fn replicate_lockstep(
-    dir: &Path,
-    spec: &GridSpec,
-    todo: &[RunKey],
+    grids: &[GridJob],
+    todo: &[(usize, RunKey)],
     path: &EvalPath,
-    finished: &(dyn Fn(Result<FinishedRun>) + Sync),
+    finished: &(dyn Fn(usize, Result<FinishedRun>) + Sync),
 ) {
-    let mut evaluators: Vec<((GridConfig, Task), PsaEvaluator)> = Vec::new();
+    let mut evaluators: Vec<CellEvaluator> = Vec::new();
     let mut started = Vec::new();
     let mut runs: Vec<AnyRun> = Vec::new();
-    for key in todo {
-        let folder = run_dir(dir, key);
-        match begin(spec, key, &folder, path, &mut evaluators) {
+    for &(grid, key) in todo {
+        let folder = run_dir(grids[grid].dir, &key);
+        match begin(grids[grid].spec, grid, &key, &folder, path, &mut evaluators) {
             Ok((run, search)) => {
                 started.push(run);
                 runs.push(search);
             }
-            Err(e) => finished(Err(e.context(format!("run {}", folder.display())))),
+            Err(e) => finished(grid, Err(e.context(format!("run {}", folder.display())))),
         }
     }
     let which: Vec<&PsaEvaluator> = started.iter().map(|s| &evaluators[s.evaluator].1).collect();
-    let folders: Vec<PathBuf> = started.iter().map(|s| run_dir(dir, &s.key).join(CHECKPOINT)).collect();
+    let folders: Vec<PathBuf> = started
+        .iter()
+        .map(|s| run_dir(grids[s.grid].dir, &s.key).join(CHECKPOINT))
+        .collect();
     let live: Vec<Mutex<&mut RunStart>> = started.iter_mut().map(|s| Mutex::new(&mut s.start)).collect();
     let on_record = |run: usize, record: &_| {
         live[run]
@@ -100,6 +109,7 @@ pub(super) fn replicate_lockstep(
         .zip(errors)
         .with_max_len(1)
         .for_each(|((run, search), error)| {
+            let GridJob { dir, spec, .. } = grids[run.grid];
             let folder = run_dir(dir, &run.key);
             let outcome = match error {
                 Some(e) => Err(e.into()),
@@ -112,6 +122,7 @@ pub(super) fn replicate_lockstep(
                 }),
             };
             finished(
+                run.grid,
                 outcome
                     .with_context(|| format!("run {}", folder.display()))
                     .and_then(|outcome| test_and_mark(dir, spec, &run.key, outcome)),
@@ -170,20 +181,21 @@ fn resume(folder: &Path, fresh: AnyRun) -> AnyRun {
     }
 }
 
-/// Starts run `key` in `folder` (its `config.toml`, as the run-by-run
-/// executor writes it) and its search, resumed from its checkpoint if it
-/// has one; finds or makes its evaluator.
+/// Starts run `key` of grid `grid` (of definition `spec`) in `folder` (its
+/// `config.toml`, as the run-by-run executor writes it) and its search,
+/// resumed from its checkpoint if it has one; finds or makes its evaluator.
 fn begin(
     spec: &GridSpec,
+    grid: usize,
     key: &RunKey,
     folder: &Path,
     path: &EvalPath,
-    evaluators: &mut Vec<((GridConfig, Task), PsaEvaluator)>,
+    evaluators: &mut Vec<CellEvaluator>,
 ) -> Result<(Started, AnyRun)> {
     let config = spec.run_config(key.config)?;
     let seed = run_seed(key);
     let mut start = RunStart::new(&config, folder)?;
-    let cell = (key.config, key.task);
+    let cell = (grid, key.config, key.task);
     let evaluator = match evaluators.iter().position(|(c, _)| *c == cell) {
         Some(index) => index,
         None => {
@@ -212,6 +224,7 @@ fn begin(
     }
     Ok((
         Started {
+            grid,
             key: *key,
             config,
             seed,

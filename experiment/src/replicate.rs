@@ -185,46 +185,90 @@ pub fn replicate(
     options: &ReplicateOptions,
     progress: &dyn GridProgress,
 ) -> Result<ReplicateSummary> {
+    let job = GridJob {
+        dir,
+        spec,
+        shard: options.shard,
+    };
+    let mut summaries = replicate_grids(&[job], options, progress)?;
+    Ok(summaries.remove(0))
+}
+
+/// One grid of those [`replicate_grids`] runs together: its folder, its
+/// definition and the shard of its run order this process does.
+#[derive(Debug, Clone, Copy)]
+pub struct GridJob<'a> {
+    /// The grid's folder.
+    pub dir: &'a Path,
+    /// Its definition.
+    pub spec: &'a GridSpec,
+    /// The runs of it this process does.
+    pub shard: Shard,
+}
+
+/// Runs several grids (a sweep's variants) as one, as [`replicate`] runs
+/// one (`options.shard` aside: each grid names its own): their unfinished
+/// runs share the threads, and with [`Executor::Lockstep`] all of them
+/// advance in one pass, each round's networks of every grid evaluated as
+/// one batch. Returns each grid's summary, in the order of `grids`; its
+/// `seconds` are those of the whole call.
+pub fn replicate_grids(
+    grids: &[GridJob],
+    options: &ReplicateOptions,
+    progress: &dyn GridProgress,
+) -> Result<Vec<ReplicateSummary>> {
     let clock = Instant::now();
-    let (todo, skipped) = prepare(dir, spec, options.shard)?;
-    progress.start(todo.len() + skipped, skipped);
+    let mut todo: Vec<(usize, RunKey)> = Vec::new();
+    let mut skipped = Vec::new();
+    for (grid, job) in grids.iter().enumerate() {
+        let (runs, finished) = prepare(job.dir, job.spec, job.shard)?;
+        todo.extend(runs.into_iter().map(|key| (grid, key)));
+        skipped.push(finished);
+    }
+    let skipped_in_all: usize = skipped.iter().sum();
+    progress.start(todo.len() + skipped_in_all, skipped_in_all);
     let pool = crate::ode::thread_pool(options.threads)?;
     let failures = Mutex::new(Vec::new());
     let held = Mutex::new(Vec::new());
-    let ran = AtomicU64::new(0);
-    let finished_elsewhere = AtomicU64::new(0);
+    let counter = || grids.iter().map(|_| AtomicU64::new(0)).collect::<Vec<_>>();
+    let (ran, finished_elsewhere) = (counter(), counter());
     let lock = "no panics while holding the lock";
-    let finished = |result: Result<FinishedRun>| match result {
+    let finished = |grid: usize, result: Result<FinishedRun>| match result {
         Ok(run) => {
-            ran.fetch_add(1, Ordering::Relaxed);
+            ran[grid].fetch_add(1, Ordering::Relaxed);
             progress.finished(&run);
         }
         Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
     };
-    // The claim on `key` if the run is this process's; the other outcomes
-    // are counted here.
-    let take = |key: &RunKey| match claim_unfinished(dir, spec, key, options.claim_timeout) {
-        Ok(Claimed::Mine(claim)) => Some(claim),
-        Ok(Claimed::AlreadyFinished) => {
-            finished_elsewhere.fetch_add(1, Ordering::Relaxed);
-            None
-        }
-        Ok(Claimed::Held(claim)) => {
-            held.lock().expect(lock).push(HeldRun { key: *key, claim });
-            None
-        }
-        Err(e) => {
-            finished(Err(e));
-            None
+    // The claim on a run if it is this process's; the other outcomes are
+    // counted here.
+    let take = |&(grid, key): &(usize, RunKey)| {
+        let job = &grids[grid];
+        match claim_unfinished(job.dir, job.spec, &key, options.claim_timeout) {
+            Ok(Claimed::Mine(claim)) => Some(claim),
+            Ok(Claimed::AlreadyFinished) => {
+                finished_elsewhere[grid].fetch_add(1, Ordering::Relaxed);
+                None
+            }
+            Ok(Claimed::Held(claim)) => {
+                held.lock().expect(lock).push((grid, HeldRun { key, claim }));
+                None
+            }
+            Err(e) => {
+                finished(grid, Err(e));
+                None
+            }
         }
     };
     pool.install(|| match options.executor {
-        Executor::RunByRun => todo.par_iter().with_max_len(1).for_each(|key| {
-            if let Some(claim) = take(key) {
+        Executor::RunByRun => todo.par_iter().with_max_len(1).for_each(|run| {
+            if let Some(claim) = take(run) {
+                let (grid, key) = run;
+                let job = &grids[*grid];
                 // The claim goes once the run's files are complete.
-                let run = run_one(dir, spec, key, &options.eval_path);
+                let outcome = run_one(job.dir, job.spec, key, &options.eval_path);
                 drop(claim);
-                finished(run);
+                finished(*grid, outcome);
             }
         }),
         Executor::Lockstep => {
@@ -232,13 +276,13 @@ pub fn replicate(
             // all are written.
             let mut claims = Vec::new();
             let mut mine = Vec::new();
-            for key in &todo {
-                if let Some(claim) = take(key) {
+            for run in &todo {
+                if let Some(claim) = take(run) {
                     claims.push(claim);
-                    mine.push(*key);
+                    mine.push(*run);
                 }
             }
-            replicate_lockstep(dir, spec, &mine, &options.eval_path, &finished);
+            replicate_lockstep(grids, &mine, &options.eval_path, &finished);
             drop(claims);
         }
     });
@@ -246,14 +290,27 @@ pub fn replicate(
     if !failures.is_empty() {
         bail!("{} run(s) failed:\n  {}", failures.len(), failures.join("\n  "));
     }
-    let mut held = held.into_inner().expect(lock);
-    let order = spec.runs();
-    held.sort_by_key(|h| order.iter().position(|k| *k == h.key));
-    Ok(ReplicateSummary {
-        total: todo.len() + skipped,
-        skipped: skipped + finished_elsewhere.load(Ordering::Relaxed) as usize,
-        ran: ran.load(Ordering::Relaxed) as usize,
-        held,
-        seconds: clock.elapsed().as_secs_f64(),
-    })
+    let held = held.into_inner().expect(lock);
+    let seconds = clock.elapsed().as_secs_f64();
+    Ok(grids
+        .iter()
+        .enumerate()
+        .map(|(grid, job)| {
+            let order = job.spec.runs();
+            let mut mine: Vec<HeldRun> = held
+                .iter()
+                .filter(|(g, _)| *g == grid)
+                .map(|(_, h)| h.clone())
+                .collect();
+            mine.sort_by_key(|h| order.iter().position(|k| *k == h.key));
+            let to_do = todo.iter().filter(|(g, _)| *g == grid).count();
+            ReplicateSummary {
+                total: to_do + skipped[grid],
+                skipped: skipped[grid] + finished_elsewhere[grid].load(Ordering::Relaxed) as usize,
+                ran: ran[grid].load(Ordering::Relaxed) as usize,
+                held: mine,
+                seconds,
+            }
+        })
+        .collect())
 }

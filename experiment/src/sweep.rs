@@ -17,7 +17,7 @@ use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use super::grid::GridSpec;
-use super::replicate::{replicate, GridProgress, HeldRun, ReplicateOptions, ReplicateSummary};
+use super::replicate::{replicate_grids, GridJob, GridProgress, HeldRun, ReplicateOptions};
 use super::RunConfig;
 
 /// The `format` of `sweep.json`.
@@ -322,9 +322,10 @@ pub struct SweepSummary {
 }
 
 /// Runs every variant's grid in `dir` (a new folder gets `sweep.json`; an
-/// existing sweep must have the same definition), variant after variant.
-/// `options.shard` splits the sweep's whole run order (the variants' run
-/// orders one after another), round-robin as a grid's.
+/// existing sweep must have the same definition), all variants' runs
+/// together ([`replicate_grids`]: in lockstep, one pass for the whole
+/// sweep). `options.shard` splits the sweep's whole run order (the
+/// variants' run orders one after another), round-robin as a grid's.
 pub fn sweep(
     dir: &Path,
     spec: &SweepSpec,
@@ -333,35 +334,43 @@ pub fn sweep(
 ) -> Result<SweepSummary> {
     prepare(dir, spec)?;
     let variants = spec.variants();
+    let mut grids = Vec::new();
+    for variant in &variants {
+        let grid = spec
+            .variant_grid(variant)
+            .with_context(|| format!("variant {}", variant.name))?;
+        grids.push((variant_dir(dir, variant), grid));
+    }
+    let mut before = 0;
+    let jobs: Vec<GridJob> = grids
+        .iter()
+        .map(|(folder, grid)| {
+            let shard = options.shard.after(before);
+            before += grid.runs().len();
+            GridJob {
+                dir: folder,
+                spec: grid,
+                shard,
+            }
+        })
+        .collect();
+    let summaries = replicate_grids(&jobs, options, progress)?;
+    let seconds = summaries.first().map_or(0.0, |s| s.seconds);
     let mut summary = SweepSummary {
         variants: variants.len(),
         total: 0,
         skipped: 0,
         ran: 0,
         held: Vec::new(),
-        seconds: 0.0,
+        seconds,
     };
-    let mut before = 0;
-    for variant in &variants {
-        let grid = spec.variant_grid(variant)?;
-        let variant_options = ReplicateOptions {
-            shard: options.shard.after(before),
-            ..options.clone()
-        };
-        before += grid.runs().len();
-        let ReplicateSummary {
-            total,
-            skipped,
-            ran,
-            held,
-            seconds,
-        } = replicate(&variant_dir(dir, variant), &grid, &variant_options, progress)
-            .with_context(|| format!("variant {}", variant.name))?;
-        summary.total += total;
-        summary.skipped += skipped;
-        summary.ran += ran;
-        summary.held.extend(held.into_iter().map(|h| (variant.name.clone(), h)));
-        summary.seconds += seconds;
+    for (variant, grid) in variants.iter().zip(summaries) {
+        summary.total += grid.total;
+        summary.skipped += grid.skipped;
+        summary.ran += grid.ran;
+        summary
+            .held
+            .extend(grid.held.into_iter().map(|h| (variant.name.clone(), h)));
     }
     Ok(summary)
 }
