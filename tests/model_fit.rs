@@ -208,8 +208,15 @@ fn a_sweep_runs_a_grid_per_variant_and_reports_the_distance_and_sensitivity() {
         "--out",
         out.to_str().unwrap(),
     ];
-    let first = ok(&psa_esp(&args));
+    let o = psa_esp(&args);
+    let first = ok(&o);
     assert!(first.contains("4 variants, 48 runs"), "{first}");
+    // All variants run together: each finished run's line names its variant.
+    let lines = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        lines.contains("v3-esp.stagnation=5+problem.tasks.task3_speed=0.2: finished max-credit task 3 seed 2"),
+        "{lines}"
+    );
     // Again: resumed, nothing to do.
     let again = ok(&psa_esp(&args));
     assert!(again.contains("48 already finished, 0 run now"), "{again}");

@@ -24,8 +24,8 @@ pub trait GridProgress: Sync {
     /// The grid (or this shard of it) has `total` runs, `done` of them
     /// finished before this call.
     fn start(&self, total: usize, done: usize);
-    /// A run finished.
-    fn finished(&self, run: &FinishedRun);
+    /// A run of the grid in folder `grid` finished.
+    fn finished(&self, grid: &Path, run: &FinishedRun);
 }
 
 /// How [`replicate`] runs: threads, shard, claims, executor and evaluation
@@ -236,7 +236,7 @@ pub fn replicate_grids(
     let finished = |grid: usize, result: Result<FinishedRun>| match result {
         Ok(run) => {
             ran[grid].fetch_add(1, Ordering::Relaxed);
-            progress.finished(&run);
+            progress.finished(grids[grid].dir, &run);
         }
         Err(e) => failures.lock().expect(lock).push(format!("{e:#}")),
     };

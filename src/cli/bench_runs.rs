@@ -112,7 +112,7 @@ pub fn evolve_workload(generations: usize) -> Result<Workload> {
 struct Silent;
 impl GridProgress for Silent {
     fn start(&self, _: usize, _: usize) {}
-    fn finished(&self, _: &FinishedRun) {}
+    fn finished(&self, _: &std::path::Path, _: &FinishedRun) {}
 }
 
 /// A small grid (baseline and max-credit, 3 tasks, 2 seeds, 50-trial

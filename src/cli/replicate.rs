@@ -1,7 +1,7 @@
 //! `psa-esp replicate`: the paper's experiment grid.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -173,6 +173,8 @@ pub struct Progress {
     /// The bar (hidden unless standard error is a terminal).
     pub bar: indicatif::ProgressBar,
     lines: bool,
+    /// Whether a finished run's line names its grid's folder (a sweep's variant).
+    name_grids: bool,
     state: Mutex<ProgressState>,
 }
 
@@ -186,8 +188,9 @@ struct ProgressState {
 }
 
 impl Progress {
-    /// A bar on a terminal, lines elsewhere, nothing when `quiet`.
-    pub fn new(quiet: bool) -> Progress {
+    /// A bar on a terminal, lines elsewhere, nothing when `quiet`; with
+    /// `name_grids`, each finished run's line names its grid's folder.
+    pub fn new(quiet: bool, name_grids: bool) -> Progress {
         let bar = progress_bar(
             0,
             "{spinner} runs {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
@@ -199,6 +202,7 @@ impl Progress {
         Progress {
             bar,
             lines: !quiet && !terminal,
+            name_grids,
             state: Mutex::new(ProgressState {
                 total: 0,
                 done: 0,
@@ -225,13 +229,17 @@ impl GridProgress for Progress {
         self.bar.reset_eta();
     }
 
-    fn finished(&self, run: &FinishedRun) {
+    fn finished(&self, grid: &Path, run: &FinishedRun) {
         let mut state = self.state.lock().expect("no panics while holding the lock");
         state.best = state.best.max(run.outcome.champion_fitness);
         state.done += 1;
         state.ran += 1;
+        let variant = match grid.file_name() {
+            Some(name) if self.name_grids => format!("{}: ", name.to_string_lossy()),
+            _ => String::new(),
+        };
         let what = format!(
-            "finished {} task {} seed {}: champion {:.1} % ({:.0} s)",
+            "{variant}finished {} task {} seed {}: champion {:.1} % ({:.0} s)",
             run.key.config, run.key.task, run.key.seed, run.outcome.champion_fitness, run.outcome.seconds
         );
         if self.lines {
@@ -261,7 +269,7 @@ pub fn report_held<'a>(held: impl Iterator<Item = (String, &'a HeldRun)>) {
 /// Runs `replicate`.
 pub fn run(args: ReplicateArgs) -> Result<i32> {
     let spec = args.grid.spec()?;
-    let progress = Progress::new(args.grid.quiet);
+    let progress = Progress::new(args.grid.quiet, false);
     let options = args.grid.options()?;
     let summary = replicate(&args.out, &spec, &options, &progress)?;
     progress.bar.finish_and_clear();

@@ -32,7 +32,7 @@ pub struct SweepArgs {
 pub fn run(args: SweepArgs) -> Result<i32> {
     let vary = args.vary.iter().map(|v| parse_vary(v)).collect::<Result<Vec<_>>>()?;
     let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
-    let progress = Progress::new(args.grid.quiet);
+    let progress = Progress::new(args.grid.quiet, true);
     let summary = sweep(&args.out, &spec, &args.grid.options()?, &progress)?;
     progress.bar.finish_and_clear();
     report_held(summary.held.iter().map(|(variant, h)| (format!("{variant}: "), h)));

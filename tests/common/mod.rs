@@ -93,12 +93,14 @@ pub fn assert_same_runs(a: &Path, b: &Path) {
     }
 }
 
-/// The runs (`configuration task seed`) a replicate's standard error says
-/// it finished.
+/// The runs (`configuration task seed`, after `variant: ` in a sweep) a
+/// replicate's or a sweep's standard error says it finished.
 pub fn finished_lines(stderr: &[u8]) -> Vec<String> {
     String::from_utf8_lossy(stderr)
         .lines()
-        .filter_map(|l| l.strip_prefix("finished "))
-        .map(|l| l.split(':').next().unwrap().to_string())
+        .filter_map(|l| match l.split_once(": finished ") {
+            Some((variant, run)) => Some(format!("{variant}: {}", run.split(':').next().unwrap())),
+            None => Some(l.strip_prefix("finished ")?.split(':').next().unwrap().to_string()),
+        })
         .collect()
 }
