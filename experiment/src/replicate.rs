@@ -219,11 +219,14 @@ pub fn replicate_grids(
 ) -> Result<Vec<ReplicateSummary>> {
     let clock = Instant::now();
     let mut todo: Vec<(usize, RunKey)> = Vec::new();
+    // Per grid: its runs in this shard, and those finished before.
+    let mut totals = Vec::new();
     let mut skipped = Vec::new();
     for (grid, job) in grids.iter().enumerate() {
         let (runs, finished) = prepare(job.dir, job.spec, job.shard)?;
-        todo.extend(runs.into_iter().map(|key| (grid, key)));
+        totals.push(runs.len() + finished);
         skipped.push(finished);
+        todo.extend(runs.into_iter().map(|key| (grid, key)));
     }
     let skipped_in_all: usize = skipped.iter().sum();
     progress.start(todo.len() + skipped_in_all, skipped_in_all);
@@ -303,9 +306,8 @@ pub fn replicate_grids(
                 .map(|(_, h)| h.clone())
                 .collect();
             mine.sort_by_key(|h| order.iter().position(|k| *k == h.key));
-            let to_do = todo.iter().filter(|(g, _)| *g == grid).count();
             ReplicateSummary {
-                total: to_do + skipped[grid],
+                total: totals[grid],
                 skipped: skipped[grid] + finished_elsewhere[grid].load(Ordering::Relaxed) as usize,
                 ran: ran[grid].load(Ordering::Relaxed) as usize,
                 held: mine,
