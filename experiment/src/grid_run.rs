@@ -52,21 +52,23 @@ pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey, path: &EvalPath) -> Re
     let seed = run_seed(key);
     let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, path, |_| {})
         .with_context(|| format!("run {}", folder.display()))?;
-    test_and_mark(dir, spec, key, outcome)
+    test_and_mark(dir, spec, key, outcome, path)
 }
 
-/// A run's robustness tests, once its evolution is written, and its ODE
-/// check when `spec.ode_check` (recorded in `run.json`; a difference is an
-/// error naming the run); then writes `robustness.json`, which marks it
-/// finished.
+/// A run's robustness tests (their trials on `path`'s kernel where it has
+/// one, as [`test_robustness`] says), once its evolution is written, and
+/// its ODE check when `spec.ode_check` (recorded in `run.json`; a
+/// difference is an error naming the run); then writes `robustness.json`,
+/// which marks it finished.
 pub(crate) fn test_and_mark(
     dir: &Path,
     spec: &GridSpec,
     key: &RunKey,
     mut outcome: EvolveOutcome,
+    path: &EvalPath,
 ) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
-    let (champion, scoring, robustness) = score_champion(&folder, spec, key, outcome.seed)?;
+    let (champion, scoring, robustness) = score_champion(&folder, spec, key, outcome.seed, path)?;
     if spec.ode_check {
         let check = check_on_ode(
             &champion,
@@ -86,17 +88,25 @@ pub(crate) fn test_and_mark(
 }
 
 /// The robustness tests of the champion in `folder` (run `key` of `spec`,
-/// run seed `seed`) under the grid's scoring configuration; returns the
+/// run seed `seed`) under the grid's scoring configuration, on `path`; returns the
 /// champion, that configuration and the results.
 pub(crate) fn score_champion(
     folder: &Path,
     spec: &GridSpec,
     key: &RunKey,
     seed: u64,
+    path: &EvalPath,
 ) -> Result<(crate::network::Network, crate::RunConfig, Robustness)> {
     let scoring = spec.scoring_config(key.config)?;
     let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
-    let mut robustness = test_robustness(&champion, key.task, &scoring.problem, spec.robustness_trials, seed)?;
+    let mut robustness = test_robustness(
+        &champion,
+        key.task,
+        &scoring.problem,
+        spec.robustness_trials,
+        seed,
+        path,
+    )?;
     robustness.rescored |= spec.rescoring.is_some();
     Ok((champion, scoring, robustness))
 }

@@ -4,7 +4,8 @@
 //! in one batch (the search crate's [`lockstep_with`]).
 //! Each run is the run it is on its own, bit for bit: its files are
 //! byte-identical to those of the run-by-run executor (run.json's times
-//! aside). Every `CHECKPOINT_ROUNDS` rounds each unfinished run saves its
+//! aside). Every `CHECKPOINT_ROUNDS` rounds or more (so that saving takes
+//! at most `CHECKPOINT_SHARE` of the time) each unfinished run saves its
 //! whole state to [`CHECKPOINT`] in its folder; a grid killed and started
 //! again resumes each run from there, to the same files.
 
@@ -26,9 +27,15 @@ use crate::psa::Task;
 /// A lockstep run's saved state, in its folder while it is unfinished.
 pub const CHECKPOINT: &str = "checkpoint.json";
 
-/// Rounds between two checkpoints of the runs (a round is a generation, or
-/// an ESP lesion test).
+/// Rounds between two checkpoints of the runs at least (a round is a
+/// generation, or an ESP lesion test).
 const CHECKPOINT_ROUNDS: usize = 20;
+
+/// The share of a grid's time that saving checkpoints may take at most:
+/// where rounds are fast (on a GPU), checkpoints are spaced further than
+/// [`CHECKPOINT_ROUNDS`] apart, so that a save's time is at most this share
+/// of the time since the last one.
+const CHECKPOINT_SHARE: f64 = 0.05;
 
 /// How `replicate` and `sweep` advance the runs of a grid. Results do not
 /// depend on it.
@@ -97,9 +104,14 @@ pub(super) fn replicate_lockstep(
             .record(record);
         Control::Continue
     };
+    let (mut last_save, mut save_time) = (std::time::Instant::now(), std::time::Duration::ZERO);
     let errors = lockstep_with(&mut runs, &which, on_record, |round, runs| {
-        if round % CHECKPOINT_ROUNDS == 0 {
+        if round % CHECKPOINT_ROUNDS == 0
+            && save_time.as_secs_f64() <= CHECKPOINT_SHARE * last_save.elapsed().as_secs_f64()
+        {
+            let start = std::time::Instant::now();
             save_checkpoints(runs, &folders);
+            (last_save, save_time) = (std::time::Instant::now(), start.elapsed());
         }
     });
     drop(live);
@@ -125,7 +137,7 @@ pub(super) fn replicate_lockstep(
                 run.grid,
                 outcome
                     .with_context(|| format!("run {}", folder.display()))
-                    .and_then(|outcome| test_and_mark(dir, spec, &run.key, outcome)),
+                    .and_then(|outcome| test_and_mark(dir, spec, &run.key, outcome, path)),
             );
         });
 }

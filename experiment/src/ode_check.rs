@@ -10,6 +10,7 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use super::robustness::{test_robustness, Robustness};
+use crate::evaluator::EvalPath;
 use crate::network::Network;
 use crate::physics::BackendKind;
 use crate::psa::{PsaSettings, Task, TrialRunner};
@@ -142,7 +143,7 @@ pub fn check_on_ode(
         native: fitness(&native)?,
         ode: fitness(&ode)?,
     };
-    let ode_robustness = test_robustness(champion, task, &ode, trials, seed)?;
+    let ode_robustness = test_robustness(champion, task, &ode, trials, seed, &EvalPath::Fastest)?;
     Ok(OdeCheck::new(fitness, native_robustness, &ode_robustness))
 }
 
@@ -162,7 +163,7 @@ mod tests {
             })
             .find(|network| {
                 let mean = |seed| {
-                    test_robustness(network, Task::StopAtPosition, &native(), 4, seed)
+                    test_robustness(network, Task::StopAtPosition, &native(), 4, seed, &EvalPath::Fastest)
                         .unwrap()
                         .input_noise
                         .mean
@@ -183,7 +184,7 @@ mod tests {
     #[test]
     fn the_same_flights_on_both_backends_are_identical() {
         let (task, seed) = (Task::StopAtPosition, 5);
-        let robustness = test_robustness(&champion(), task, &native(), 4, seed).unwrap();
+        let robustness = test_robustness(&champion(), task, &native(), 4, seed, &EvalPath::Fastest).unwrap();
         let check = check_on_ode(&champion(), task, &native(), 4, seed, &robustness).unwrap();
         assert!(check.identical, "{check:?}");
         assert_eq!(check.robustness.len(), 5);
@@ -195,14 +196,14 @@ mod tests {
         // Real flights that differ: the native results of another seed
         // (another noise draw) against the ode results of this one.
         let (task, seed) = (Task::StopAtPosition, 5);
-        let other = test_robustness(&champion(), task, &native(), 4, seed + 1).unwrap();
+        let other = test_robustness(&champion(), task, &native(), 4, seed + 1, &EvalPath::Fastest).unwrap();
         let check = check_on_ode(&champion(), task, &native(), 4, seed, &other).unwrap();
         assert!(!check.identical);
         let on_ode = PsaSettings {
             backend: BackendKind::Ode,
             ..native()
         };
-        let ode = test_robustness(&champion(), task, &on_ode, 4, seed).unwrap();
+        let ode = test_robustness(&champion(), task, &on_ode, 4, seed, &EvalPath::Fastest).unwrap();
         // The clean flight draws nothing: the same; the noisy mean differs.
         assert!(check.robustness["clean"].identical());
         let (native_mean, ode_mean) = (other.input_noise.mean, ode.input_noise.mean);

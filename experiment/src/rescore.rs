@@ -13,6 +13,7 @@ use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
 use super::grid_run::{mark_finished, run_seed, score_champion};
 use super::replicate::prepare;
 use super::shard::Shard;
+use crate::evaluator::EvalPath;
 
 /// The files of a run that re-scoring copies unchanged (its evolution).
 const EVOLUTION_FILES: [&str; 4] = ["config.toml", "records.csv", "champion.json", "run.json"];
@@ -112,7 +113,7 @@ fn rescore_run(source: &Path, out: &Path, spec: &GridSpec, key: &RunKey) -> Resu
             std::fs::read(from.join(name)).with_context(|| format!("cannot read {}", from.join(name).display()))?;
         crate::io::write_atomic(&to.join(name), &bytes)?;
     }
-    let (_, _, robustness) =
-        score_champion(&to, spec, key, run_seed(key)).with_context(|| format!("re-scoring {}", from.display()))?;
+    let (_, _, robustness) = score_champion(&to, spec, key, run_seed(key), &EvalPath::Fastest)
+        .with_context(|| format!("re-scoring {}", from.display()))?;
     mark_finished(&to, &robustness)
 }

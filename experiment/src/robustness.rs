@@ -5,8 +5,9 @@ use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
 use super::PAPER_NOISE_SD;
+use crate::evaluator::{trial_scores, EvalPath};
 use crate::network::Network;
-use crate::psa::{NoiseSettings, PsaSettings, Task, TrialRunner};
+use crate::psa::{mean_of_trials, NoiseSettings, PsaSettings, Task};
 use crate::rng::stream;
 
 /// Stream keys of the robustness tests (the evolution's own keys are below 100).
@@ -60,13 +61,16 @@ pub struct Robustness {
 /// run's control problem, scored with its scoring fitness
 /// ([`PsaSettings::scoring_for`]); its noise, random initialisation and
 /// trials are replaced by each test's own (the input noise keeps whether it
-/// reaches the bias).
+/// reaches the bias). Each test's trials fly on `path`'s kernel (the GPU
+/// with `--backend cuda`) in one launch where it has one, else on the
+/// scalar path: the same scores either way.
 pub fn test_robustness(
     champion: &Network,
     task: Task,
     problem: &PsaSettings,
     trials: usize,
     seed: u64,
+    path: &EvalPath,
 ) -> Result<Robustness> {
     let scored = problem.scoring_for(task)?;
     let base = PsaSettings {
@@ -78,7 +82,9 @@ pub fn test_robustness(
         trials: 1,
         ..scored
     };
-    let clean = TrialRunner::new(&base, task)?.evaluate(champion, &mut stream(seed, &[CLEAN]))?;
+    let scores =
+        |settings: &PsaSettings, key: u64| trial_scores(settings, task, champion, &mut stream(seed, &[key]), path);
+    let clean = mean_of_trials(&scores(&base, CLEAN)?);
     let noisy = PsaSettings {
         noise: NoiseSettings {
             input_sd: PAPER_NOISE_SD,
@@ -87,18 +93,14 @@ pub fn test_robustness(
         trials,
         ..base.clone()
     };
-    let input_noise = TrialSummary::of(
-        &TrialRunner::new(&noisy, task)?.evaluate_trials(champion, &mut stream(seed, &[INPUT_NOISE]))?,
-    );
+    let input_noise = TrialSummary::of(&scores(&noisy, INPUT_NOISE)?);
     let random_init = if task.has_random_init() {
         let random = PsaSettings {
             random_init: true,
             trials,
             ..base
         };
-        Some(TrialSummary::of(
-            &TrialRunner::new(&random, task)?.evaluate_trials(champion, &mut stream(seed, &[RANDOM_INIT]))?,
-        ))
+        Some(TrialSummary::of(&scores(&random, RANDOM_INIT)?))
     } else {
         None
     };

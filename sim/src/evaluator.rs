@@ -82,6 +82,28 @@ impl std::str::FromStr for EvalPath {
     }
 }
 
+/// Each trial's score (in % of the theoretical maximum) of `network` on
+/// `task` under `settings`, with `rng` (as [`TrialRunner::evaluate_trials`]
+/// gives them, bit for bit): on `path`'s kernel (a GPU, or the host build)
+/// in one launch where it has one, else on the scalar path. The robustness
+/// tests' many trials of a champion.
+pub fn trial_scores(
+    settings: &PsaSettings,
+    task: Task,
+    network: &Network,
+    rng: &mut Stream,
+    path: &EvalPath,
+) -> Result<Vec<f64>> {
+    let flier: Arc<dyn TrialFlier> = match path {
+        EvalPath::Kernel(flier) => flier.clone(),
+        EvalPath::KernelOnHost => Arc::new(HostTrials),
+        _ => return Ok(TrialRunner::new(settings, task)?.evaluate_trials(network, rng)?),
+    };
+    Ok(cuda::trial_scores_with(settings, task, network, rng, |batch| {
+        flier.fly(batch)
+    })?)
+}
+
 /// Scores a network by its fitness on a task (in % of the theoretical
 /// maximum, the mean over `settings.trials` trials), on the [`EvalPath`] it
 /// was made with: on `native` the batched SIMD path ([`BatchRunner`]) or a

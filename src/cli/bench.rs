@@ -14,7 +14,7 @@ use anyhow::Result;
 use multiversion::multiversion;
 use serde::Serialize;
 
-use super::bench_kernel::{kernel_rows, KERNEL_NETWORKS};
+use super::bench_kernel::{kernel_rows, KernelBench, KERNEL_NETWORKS};
 use super::bench_networks::{random_networks, HIDDEN};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
 use crate::evaluator::{EvalPath, PsaEvaluator};
@@ -51,6 +51,9 @@ pub struct BenchArgs {
     /// of a GPU (the rows' plumbing without one, slowly).
     #[arg(long)]
     pub kernel_host: bool,
+    /// Time only the cuda kernel's rows (for a GPU machine's short lease).
+    #[arg(long)]
+    pub kernel_only: bool,
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
@@ -266,6 +269,18 @@ fn time_steps(backend: &mut dyn PhysicsBackend, commands: &[Vec<f64>], steps: u6
 
 /// Runs `bench`.
 pub fn run(args: BenchArgs) -> Result<i32> {
+    if args.kernel_only {
+        let kernel = kernel_rows(&args.kernel_networks, args.rounds, args.kernel_host)?;
+        if args.json {
+            say!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({ "cuda_kernel": kernel }))?
+            );
+        } else {
+            print_kernel_rows(&kernel)?;
+        }
+        return Ok(0);
+    }
     let model = BodySettings::default().model()?;
     let settings = crate::physics::StepSettings::default();
     let commands = random_thrust_sequence(1, 0, 500, model.thrusters.len());
@@ -437,29 +452,39 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             overhead.percent,
             overhead.description
         );
-        match &kernel.unavailable {
-            Some(why) => say!("cuda kernel: not measured: {why}"),
-            None => {
-                say!(
-                    "cuda kernel on {} against native batched on 1 thread (task 1, one launch per round, median):",
-                    kernel.device
-                );
-                say!(
-                    "{:>10} {:>22} {:>22}",
-                    "networks",
-                    "kernel ns/net-step",
-                    "native ns/net-step"
-                );
-                for row in &kernel.rows {
-                    say!(
-                        "{:>10} {:>22.3} {:>22.3}",
-                        row.networks,
-                        row.kernel_ns_per_network_step,
-                        row.native_ns_per_network_step
-                    );
-                }
-            }
-        }
+        print_kernel_rows(&kernel)?;
     }
     Ok(0)
+}
+
+/// The cuda kernel's rows as a table.
+fn print_kernel_rows(kernel: &KernelBench) -> Result<()> {
+    let Some(why) = &kernel.unavailable else {
+        say!(
+            "cuda kernel on {} against native batched on 1 thread (task 1, one launch per round, median):",
+            kernel.device
+        );
+        say!(
+            "{:>10} {:>22} {:>24} {:>20}",
+            "networks",
+            "kernel ns/net-step",
+            "with copies ns/net-step",
+            "native ns/net-step"
+        );
+        for row in &kernel.rows {
+            let kernel_ns = row
+                .kernel_ns_per_network_step
+                .map_or_else(|| "-".to_string(), |ns| format!("{ns:.4}"));
+            say!(
+                "{:>10} {:>22} {:>24.4} {:>20.3}",
+                row.networks,
+                kernel_ns,
+                row.end_to_end_ns_per_network_step,
+                row.native_ns_per_network_step
+            );
+        }
+        return Ok(());
+    };
+    say!("cuda kernel: not measured: {why}");
+    Ok(())
 }

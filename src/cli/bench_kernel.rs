@@ -1,5 +1,6 @@
 //! `bench`'s rows for the cuda path's trial kernel: ns per network-step on
-//! the GPU beside the `native` batched path, at several networks per
+//! the GPU (the kernel alone, by CUDA events, and a launch end to end with
+//! its copies) beside the `native` batched path, at several networks per
 //! launch (400, one generation of one run; 4,000; 312,000, one generation
 //! of every run of the paper grid).
 
@@ -15,6 +16,9 @@ use crate::physics::{BackendKind, PlanarBody};
 use crate::psa::cuda::{prepare, CudaTrials, HostTrials, TrialFlier};
 use crate::psa::{BatchRunner, PsaSettings, Task};
 
+/// Networks the `native` column flies at most.
+pub const NATIVE_NETWORKS: usize = 4_000;
+
 /// Networks per launch of the kernel rows, by default.
 pub const KERNEL_NETWORKS: [u64; 3] = [400, 4_000, 312_000];
 
@@ -23,9 +27,16 @@ pub const KERNEL_NETWORKS: [u64; 3] = [400, 4_000, 312_000];
 pub struct KernelTiming {
     /// Networks per launch.
     pub networks: u64,
-    /// ns per network-step of one launch (the median round), copies in and out included.
-    pub kernel_ns_per_network_step: f64,
-    /// ns per network-step of the same networks on the `native` batched path, 1 thread.
+    /// ns per network-step of the kernel alone (the median round; CUDA
+    /// events around the launch), where the flier times it (a GPU; not the
+    /// host build).
+    pub kernel_ns_per_network_step: Option<f64>,
+    /// ns per network-step of one launch end to end (the median round):
+    /// the copies in and out, the launch and the wait included.
+    pub end_to_end_ns_per_network_step: f64,
+    /// ns per network-step on the `native` batched path, 1 thread, of the
+    /// same networks (the first [`NATIVE_NETWORKS`] of them: one thread's
+    /// rate does not depend on how many there are).
     pub native_ns_per_network_step: f64,
 }
 
@@ -78,22 +89,25 @@ pub fn kernel_rows(sizes: &[u64], rounds: u64, on_host: bool) -> Result<KernelBe
         let networks = random_networks(size)?;
         let refs: Vec<&Network> = networks.iter().collect();
         let network_steps = (size as usize * settings.steps * settings.trials) as f64;
-        let (mut kernel, mut cpu) = (Vec::new(), Vec::new());
+        let (mut kernel, mut end_to_end, mut cpu) = (Vec::new(), Vec::new(), Vec::new());
         for round in 0..rounds {
             let mut streams: Vec<_> = (0..networks.len())
                 .map(|j| crate::rng::stream(round, &[j as u64]))
                 .collect();
             let batch = prepare(&settings, &body, task, &refs[..], 0..refs.len(), &mut streams.clone())?;
             let start = Instant::now();
-            flier.fly(&batch)?;
-            kernel.push(start.elapsed().as_secs_f64() * 1e9 / network_steps);
+            let (_, kernel_seconds) = flier.fly_timed(&batch)?;
+            end_to_end.push(start.elapsed().as_secs_f64() * 1e9 / network_steps);
+            kernel.extend(kernel_seconds.map(|s| s * 1e9 / network_steps));
+            let flown = refs.len().min(NATIVE_NETWORKS);
             let start = Instant::now();
-            native.evaluate(&refs[..], 0..refs.len(), &mut streams)?;
-            cpu.push(start.elapsed().as_secs_f64() * 1e9 / network_steps);
+            native.evaluate(&refs[..], 0..flown, &mut streams[..flown])?;
+            cpu.push(start.elapsed().as_secs_f64() * 1e9 / (network_steps * flown as f64 / refs.len() as f64));
         }
         rows.push(KernelTiming {
             networks: size,
-            kernel_ns_per_network_step: median(kernel),
+            kernel_ns_per_network_step: (!kernel.is_empty()).then(|| median(kernel)),
+            end_to_end_ns_per_network_step: median(end_to_end),
             native_ns_per_network_step: median(cpu),
         });
     }

@@ -10,6 +10,7 @@ use anyhow::Result;
 use super::backend::{BackendArg, EvalPathArg};
 use super::choice::choice;
 use super::evolve::progress_bar;
+use crate::evaluator::EvalPath;
 use crate::evolution::MAX_GENERATIONS;
 use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
 use crate::experiment::grid_run::FinishedRun;
@@ -289,6 +290,22 @@ pub fn run(args: ReplicateArgs) -> Result<i32> {
         summary.held.len(),
         summary.seconds
     );
+    report_gpu_share(&options.eval_path, summary.seconds)?;
     say!("next: psa-esp report {}", args.out.display());
     Ok(0)
+}
+
+/// With `--backend cuda`, the wall time the GPU evaluated (a launch in
+/// flight, its copies included) of the grid's `seconds`.
+pub fn report_gpu_share(path: &EvalPath, seconds: f64) -> Result<()> {
+    if let EvalPath::Kernel(flier) = path {
+        if let Some(busy) = flier.busy() {
+            let busy = busy.as_secs_f64();
+            say!(
+                "GPU evaluation (a launch in flight, copies included): {busy:.1} s of the {seconds:.1} s ({:.0} %)",
+                100.0 * busy / seconds.max(f64::MIN_POSITIVE)
+            );
+        }
+    }
+    Ok(())
 }

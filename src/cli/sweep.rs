@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use super::choice::choice;
-use super::replicate::{report_held, GridArgs, Progress};
+use super::replicate::{report_gpu_share, report_held, GridArgs, Progress};
 use crate::experiment::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
 
 /// Arguments of `sweep`.
@@ -33,7 +33,8 @@ pub fn run(args: SweepArgs) -> Result<i32> {
     let vary = args.vary.iter().map(|v| parse_vary(v)).collect::<Result<Vec<_>>>()?;
     let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
     let progress = Progress::new(args.grid.quiet, true);
-    let summary = sweep(&args.out, &spec, &args.grid.options()?, &progress)?;
+    let options = args.grid.options()?;
+    let summary = sweep(&args.out, &spec, &options, &progress)?;
     progress.bar.finish_and_clear();
     report_held(summary.held.iter().map(|(variant, h)| (format!("{variant}: "), h)));
     say!(
@@ -46,6 +47,7 @@ pub fn run(args: SweepArgs) -> Result<i32> {
         summary.held.len(),
         summary.seconds
     );
+    report_gpu_share(&options.eval_path, summary.seconds)?;
     say!("next: psa-esp report {}", args.out.display());
     Ok(0)
 }

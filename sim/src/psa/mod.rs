@@ -21,4 +21,4 @@ pub use network_file::{NetworkFile, NetworkFileError};
 pub use ode_lockstep::OdeLockstepRunner;
 pub use sensors::{HeadingInput, HeadingWrap, NoiseSettings, SensorSettings, INPUT_COUNT};
 pub use task::{Target, Task, TaskSettings};
-pub use trial::{PsaError, PsaSettings, TaskOverrides, TrialRecord, TrialRunner};
+pub use trial::{mean_of_trials, PsaError, PsaSettings, TaskOverrides, TrialRecord, TrialRunner};

@@ -455,6 +455,6 @@ fn fly_steps<const NOISY: bool>(
 
 /// An evaluation's fitness from its trials' fitness values: their mean,
 /// summed in trial order.
-pub(crate) fn mean_of_trials(trials: &[f64]) -> f64 {
+pub fn mean_of_trials(trials: &[f64]) -> f64 {
     trials.iter().sum::<f64>() / trials.len() as f64
 }

@@ -2,31 +2,45 @@
 //!
 //! `trial.cu` flies one trial per thread: the batched `native` kernel
 //! ([`super::batch`]) written out in C for one network, operation for
-//! operation, in double precision, every `mul_add` an explicit `fma`.
-//! NVRTC compiles it for the GPU with `--fmad=false`; the build compiles the
-//! same file with the host C compiler (`-ffp-contract=off`), and
-//! [`fly_on_host`] runs it, so the tests hold the kernel's arithmetic to
-//! `native` bit for bit on any machine, with or without a GPU.
+//! operation, in double precision, every `mul_add` an explicit `fma`. It is
+//! specialised at compile time ([`Specialisation`]: loop bounds, discrete
+//! settings and the exponential's polynomial as constants). NVRTC compiles
+//! each specialisation for the GPU with `--fmad=false`; [`host`] compiles
+//! the same specialisations with the host C compiler (`-ffp-contract=off`)
+//! and [`fly_on_host`] runs them, so the tests hold the kernel's arithmetic
+//! to `native` bit for bit on any machine, with or without a GPU.
 //!
 //! The host draws what the trials need from each network's own stream, in
 //! the scalar path's order ([`prepare`]): the random start, then the seed of
 //! the noise source, trial by trial; the kernel gets the start, the target
-//! and the noise generator's state. [`evaluate_with`] turns the trials'
-//! points into each network's fitness and re-runs a network whose flight
-//! ended non-finite on the scalar path, which names the error, as the
-//! batched path does.
+//! and the noise generator's state. A launch carries each distinct hidden
+//! neuron once (ESP's networks share their sub-populations' neurons) and
+//! each network as a row of neuron indices. [`evaluate_with`] turns the
+//! trials' points into each network's fitness and re-runs a network whose
+//! flight ended non-finite on the scalar path, which names the error, as
+//! the batched path does.
 
 mod device;
+pub mod host;
 
-pub use device::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME, KERNEL_SOURCE, THREADS_PER_BLOCK};
+use std::collections::HashMap;
+
+pub use device::{
+    compile_for_check, CudaTrials, CudaUnavailable, KernelShape, KERNEL_NAME, KERNEL_SOURCE, THREADS_PER_BLOCK,
+};
+pub use host::fly_on_host;
 
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{FitnessKind, FitnessState, HeadingInput, HeadingWrap, SlowingRule, Task, INPUT_COUNT, THRUSTER_COUNT};
-use crate::network::NetworkSet;
+use crate::network::{Network, NetworkSet};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use crate::rng::{expand, Stream};
 
-/// The settings every thread shares: `PsaParams` of `trial.cu`, field for field.
+/// Genes of a hidden neuron: its input weights, then its output weights.
+const GENES: usize = INPUT_COUNT + THRUSTER_COUNT;
+
+/// The settings every thread shares, passed to the kernel by value:
+/// `PsaParams` of `trial.cu`, field for field.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, zerocopy::IntoBytes, zerocopy::Immutable)]
 pub struct KernelParams {
@@ -47,20 +61,8 @@ pub struct KernelParams {
     inv_mass: f64,
     inv_inertia_z: f64,
     dt: f64,
-    exp_q: [f64; 10],
-    ln2_parts: [f64; 2],
-    force_support: [i32; THRUSTER_COUNT],
-    arm_support: [i32; THRUSTER_COUNT],
     steps: i32,
-    noisy: i32,
-    incremental: i32,
-    signed_slowing: i32,
-    exp_terms: i32,
-    ln2_terms: i32,
-    heading_absolute: i32,
-    heading_positive: i32,
-    bias_noise: i32,
-    fitness_sensed: i32,
+    padding: i32,
 }
 
 /// One trial: `PsaTrial` of `trial.cu`, field for field.
@@ -72,22 +74,104 @@ pub struct KernelTrial {
     quaternion: [f64; 2],
     omega: f64,
     target: [f64; 3],
-    noise_state: [u64; 4],
-    weights: i32,
-    hidden: i32,
+    /// Its network's row in [`TrialBatch::networks`].
+    network: i32,
+    padding: i32,
 }
 
-/// Everything one launch needs: the shared settings, the networks'
-/// weights (the active hidden neurons' genes, network after network) and
-/// the trials, network by network, the settings' `trials` each.
+/// What `trial.cu` is compiled with: the settings that are constants of
+/// its code (one compiled kernel per specialisation in use, on the GPU and
+/// on the host alike).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Specialisation {
+    /// Hidden neurons a network of the launch has at most (at least 1).
+    pub hidden: usize,
+    noisy: bool,
+    incremental: bool,
+    signed_slowing: bool,
+    heading_absolute: bool,
+    heading_positive: bool,
+    bias_noise: bool,
+    fitness_sensed: bool,
+    force_support: [i32; THRUSTER_COUNT],
+    arm_support: [i32; THRUSTER_COUNT],
+    exp_q: Vec<f64>,
+    ln2_parts: Vec<f64>,
+}
+
+impl Specialisation {
+    /// The `-D` options that compile `trial.cu` for this specialisation,
+    /// the exponential's coefficients as hexadecimal floating-point
+    /// literals, which C and C++ read back to the same bits.
+    pub fn defines(&self) -> Vec<String> {
+        let flag = |name: &str, on: bool| format!("-D{name}={}", u8::from(on));
+        let ints = |values: &[i32]| values.iter().map(i32::to_string).collect::<Vec<_>>().join(",");
+        let floats = |values: &[f64]| values.iter().map(|&v| hex_float(v)).collect::<Vec<_>>().join(",");
+        vec![
+            format!("-DPSA_HIDDEN={}", self.hidden),
+            flag("PSA_NOISY", self.noisy),
+            flag("PSA_INCREMENTAL", self.incremental),
+            flag("PSA_SIGNED_SLOWING", self.signed_slowing),
+            flag("PSA_HEADING_ABSOLUTE", self.heading_absolute),
+            flag("PSA_HEADING_POSITIVE", self.heading_positive),
+            flag("PSA_BIAS_NOISE", self.bias_noise),
+            flag("PSA_FITNESS_SENSED", self.fitness_sensed),
+            format!("-DPSA_FORCE_SUPPORT={}", ints(&self.force_support)),
+            format!("-DPSA_ARM_SUPPORT={}", ints(&self.arm_support)),
+            format!("-DPSA_EXP_TERMS={}", self.exp_q.len()),
+            format!("-DPSA_EXP_Q={}", floats(&self.exp_q)),
+            format!("-DPSA_LN2_TERMS={}", self.ln2_parts.len()),
+            format!("-DPSA_LN2_PARTS={}", floats(&self.ln2_parts)),
+        ]
+    }
+
+    /// The specialisation's name: its options in one line, the key of a
+    /// cache of compiled kernels.
+    pub fn key(&self) -> String {
+        self.defines().join(" ")
+    }
+}
+
+/// `value` as a C hexadecimal floating-point literal (`0x1.8p+1` for 3),
+/// exactly: every finite double has one, which compilers read back to the
+/// same bits.
+///
+/// # Panics
+/// If `value` is not finite.
+pub fn hex_float(value: f64) -> String {
+    assert!(value.is_finite(), "{value} has no literal");
+    let bits = value.to_bits();
+    let sign = if bits >> 63 == 1 { "-" } else { "" };
+    let exponent = ((bits >> 52) & 0x7ff) as i64;
+    let mantissa = bits & ((1 << 52) - 1);
+    match (exponent, mantissa) {
+        (0, 0) => format!("{sign}0x0p+0"),
+        (0, _) => format!("{sign}0x0.{mantissa:013x}p-1022"),
+        _ => format!("{sign}0x1.{mantissa:013x}p{:+}", exponent - 1023),
+    }
+}
+
+/// Everything one launch needs: the shared settings, the specialisation,
+/// each distinct active hidden neuron's genes once, each network's row of
+/// neuron indices, and the trials, network by network, the settings'
+/// `trials` each (with their noise generators' states where noisy).
 #[derive(Debug, Clone)]
 pub struct TrialBatch {
     /// The shared settings.
     pub params: KernelParams,
-    /// The genes of every active hidden neuron, input weights then output weights.
-    pub weights: Vec<f64>,
+    /// What the kernel is compiled with.
+    pub specialisation: Specialisation,
+    /// The genes of every distinct active hidden neuron, input weights then
+    /// output weights, neuron after neuron.
+    pub neurons: Vec<f64>,
+    /// Each network's row of `specialisation.hidden` indices into
+    /// `neurons` (in neurons): its active neurons in order, then -1.
+    pub networks: Vec<i32>,
     /// The trials: network `j`'s trial `t` at `j * trials + t`.
     pub trials: Vec<KernelTrial>,
+    /// Each trial's noise generator state (4 words), where the settings
+    /// have noise; empty where not.
+    pub noise: Vec<u64>,
 }
 
 /// The kernel's output for a batch: each trial's points, and whether its
@@ -100,17 +184,15 @@ pub struct TrialPoints {
     pub finite: Vec<i32>,
 }
 
-/// `values` at the front of an array of `M` (zeros after): a polynomial
-/// or ln 2's parts for the kernel, which reads as many as it is told.
-fn padded<const M: usize>(values: &[f64]) -> [f64; M] {
-    let mut array = [0.0; M];
-    array[..values.len()].copy_from_slice(values);
-    array
-}
-
 impl KernelParams {
-    /// The parameters of `settings` (already validated for the task) on `body`.
-    pub fn new(settings: &PsaSettings, body: &PlanarBody) -> Result<KernelParams, PsaError> {
+    /// The parameters of `settings` (already validated for the task) on
+    /// `body`, and the specialisation for networks of at most `hidden`
+    /// active hidden neurons.
+    pub fn new(
+        settings: &PsaSettings,
+        body: &PlanarBody,
+        hidden: usize,
+    ) -> Result<(KernelParams, Specialisation), PsaError> {
         let constants = body.constants();
         if constants.thrusters.len() != THRUSTER_COUNT {
             return Err(PsaError::Setting(format!(
@@ -122,7 +204,7 @@ impl KernelParams {
             .map_err(|_| PsaError::Setting(format!("{} steps are too many for the cuda kernel", settings.steps)))?;
         let t = &constants.thrusters;
         let (s, f) = (&settings.sensors, &settings.fitness);
-        Ok(KernelParams {
+        let params = KernelParams {
             position_scale: s.position_scale,
             velocity_scale: s.velocity_scale,
             heading_scale: s.heading_scale,
@@ -140,22 +222,30 @@ impl KernelParams {
             inv_mass: constants.inv_mass,
             inv_inertia_z: constants.inv_inertia_z,
             dt: constants.dt,
+            steps,
+            padding: 0,
+        };
+        let specialisation = Specialisation {
+            hidden: hidden.max(1),
+            noisy: settings.noise.is_active(),
+            incremental: f.kind == FitnessKind::Incremental,
+            signed_slowing: f.slowing == SlowingRule::Signed,
+            heading_absolute: s.heading_input == HeadingInput::Absolute,
+            heading_positive: s.heading_wrap == HeadingWrap::Positive,
+            bias_noise: settings.noise.on_bias,
+            fitness_sensed: f.state == FitnessState::Sensed,
             force_support: std::array::from_fn(|i| t[i].force_support),
             arm_support: std::array::from_fn(|i| t[i].arm_support),
-            steps,
-            noisy: settings.noise.is_active().into(),
-            incremental: (f.kind == FitnessKind::Incremental).into(),
-            signed_slowing: (f.slowing == SlowingRule::Signed).into(),
-            exp_q: padded(settings.exponential.coefficients()),
-            ln2_parts: padded(settings.exponential.ln2_parts()),
-            exp_terms: settings.exponential.coefficients().len() as i32,
-            ln2_terms: settings.exponential.ln2_parts().len() as i32,
-            heading_absolute: (s.heading_input == HeadingInput::Absolute).into(),
-            heading_positive: (s.heading_wrap == HeadingWrap::Positive).into(),
-            bias_noise: settings.noise.on_bias.into(),
-            fitness_sensed: (f.state == FitnessState::Sensed).into(),
-        })
+            exp_q: settings.exponential.coefficients().to_vec(),
+            ln2_parts: settings.exponential.ln2_parts().to_vec(),
+        };
+        Ok((params, specialisation))
     }
+}
+
+/// Network `j`'s active (not lesioned) hidden neurons.
+fn active_neurons<S: NetworkSet + ?Sized>(networks: &S, j: usize) -> impl Iterator<Item = usize> + '_ {
+    (0..networks.hidden(j)).filter(move |&k| !networks.is_lesioned(j, k))
 }
 
 /// The batch for networks `range` of `networks` on `task`, drawing each
@@ -172,24 +262,32 @@ pub fn prepare<S: NetworkSet + ?Sized>(
     range: std::ops::Range<usize>,
     rngs: &mut [Stream],
 ) -> Result<TrialBatch, PsaError> {
-    let mut batch = TrialBatch::new(settings, body)?;
+    let hidden = range.clone().map(|j| active_neurons(networks, j).count()).max();
+    let mut batch = TrialBatch::new(settings, body, hidden.unwrap_or(0))?;
     batch.append(settings, task, networks, range, rngs)?;
     Ok(batch)
 }
 
 impl TrialBatch {
     /// A batch of no trials yet, with the parameters of `settings` (already
-    /// validated for the task) on `body`.
-    pub fn new(settings: &PsaSettings, body: &PlanarBody) -> Result<TrialBatch, PsaError> {
+    /// validated for the task) on `body`, for networks of at most `hidden`
+    /// active hidden neurons.
+    pub fn new(settings: &PsaSettings, body: &PlanarBody, hidden: usize) -> Result<TrialBatch, PsaError> {
+        let (params, specialisation) = KernelParams::new(settings, body, hidden)?;
         Ok(TrialBatch {
-            params: KernelParams::new(settings, body)?,
-            weights: Vec::new(),
+            params,
+            specialisation,
+            neurons: Vec::new(),
+            networks: Vec::new(),
             trials: Vec::new(),
+            noise: Vec::new(),
         })
     }
 
-    /// Adds the weights and trials of networks `range` of `networks`, as
-    /// [`prepare`] makes them, after those already in the batch.
+    /// Adds the neurons, rows and trials of networks `range` of `networks`,
+    /// as [`prepare`] makes them, after those already in the batch. A
+    /// neuron that several of these networks share (the same genes in
+    /// memory, as in ESP's sub-populations) goes in once.
     ///
     /// # Panics
     /// If `range` and `rngs` differ in length.
@@ -203,17 +301,31 @@ impl TrialBatch {
     ) -> Result<(), PsaError> {
         assert_eq!(range.len(), rngs.len(), "one stream per network");
         let too_big = |what: &str| PsaError::Setting(format!("the cuda kernel's batch is too large ({what})"));
+        let width = self.specialisation.hidden;
+        let mut known: HashMap<*const f64, i32> = HashMap::new();
         for (j, rng) in range.zip(rngs.iter_mut()) {
             let (inputs, outputs) = networks.shape(j);
             TrialRunner::check_shape(inputs, outputs)?;
-            let offset = i32::try_from(self.weights.len()).map_err(|_| too_big("weights"))?;
-            let mut hidden: usize = 0;
-            for k in (0..networks.hidden(j)).filter(|&k| !networks.is_lesioned(j, k)) {
-                self.weights
-                    .extend_from_slice(&networks.neuron(j, k)[..INPUT_COUNT + THRUSTER_COUNT]);
-                hidden += 1;
+            let row = i32::try_from(self.networks.len() / width).map_err(|_| too_big("networks"))?;
+            let mut active = 0;
+            for k in active_neurons(networks, j) {
+                let genes = &networks.neuron(j, k)[..GENES];
+                let index = match known.get(&genes.as_ptr()) {
+                    Some(&index) => index,
+                    None => {
+                        let index = i32::try_from(self.neurons.len() / GENES).map_err(|_| too_big("neurons"))?;
+                        self.neurons.extend_from_slice(genes);
+                        known.insert(genes.as_ptr(), index);
+                        index
+                    }
+                };
+                self.networks.push(index);
+                active += 1;
             }
-            let hidden = i32::try_from(hidden).map_err(|_| too_big("hidden neurons"))?;
+            if active > width {
+                return Err(too_big(&format!("{active} hidden neurons in a batch made for {width}")));
+            }
+            self.networks.extend(std::iter::repeat_n(-1, width - active));
             for _ in 0..settings.trials {
                 let (start, target) = settings.tasks.start_and_target(task, settings.random_init, rng);
                 start.validate()?;
@@ -224,12 +336,16 @@ impl TrialBatch {
                     quaternion: state.quaternion,
                     omega: state.omega,
                     target: [target.x, target.y, target.heading],
-                    noise_state: expand(settings.noise.draw_seed(rng)),
-                    weights: offset,
-                    hidden,
+                    network: row,
+                    padding: 0,
                 });
+                let seed = settings.noise.draw_seed(rng);
+                if self.specialisation.noisy {
+                    self.noise.extend_from_slice(&expand(seed));
+                }
             }
         }
+        i32::try_from(self.trials.len()).map_err(|_| too_big("trials"))?;
         Ok(())
     }
 }
@@ -282,6 +398,47 @@ pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
     parts: &mut [KernelPart<'_, S>],
     fly: impl FnOnce(&TrialBatch) -> Result<TrialPoints, PsaError>,
 ) -> Result<Vec<Result<Vec<f64>, PsaError>>, PsaError> {
+    let scores = trial_scores_of_parts(settings, task, parts, fly)?;
+    Ok(scores
+        .into_iter()
+        .map(|part| part.map(|networks| networks.iter().map(|trials| mean_of_trials(trials)).collect()))
+        .collect())
+}
+
+/// Each trial's score (in % of the theoretical maximum) of `network` on
+/// `task`, its trials flown by `fly`: exactly what
+/// [`TrialRunner::evaluate_trials`] gives with `rng` (the robustness
+/// tests' many trials of one champion in one launch).
+pub fn trial_scores_with(
+    settings: &PsaSettings,
+    task: Task,
+    network: &Network,
+    rng: &mut Stream,
+    fly: impl FnOnce(&TrialBatch) -> Result<TrialPoints, PsaError>,
+) -> Result<Vec<f64>, PsaError> {
+    let networks = [network];
+    let mut parts = [KernelPart {
+        networks: &networks[..],
+        range: 0..1,
+        rngs: std::slice::from_mut(rng),
+    }];
+    let mut scores = trial_scores_of_parts(settings, task, &mut parts, fly)?
+        .pop()
+        .expect("one part")?;
+    Ok(scores.pop().expect("one network"))
+}
+
+/// A part's networks' trial scores, network by network, or its error.
+type PartScores = Result<Vec<Vec<f64>>, PsaError>;
+
+/// Each part's networks' trial scores (in % of the theoretical maximum),
+/// all parts flown in one flight of `fly`, or the part's own error.
+fn trial_scores_of_parts<S: NetworkSet + ?Sized>(
+    settings: &PsaSettings,
+    task: Task,
+    parts: &mut [KernelPart<'_, S>],
+    fly: impl FnOnce(&TrialBatch) -> Result<TrialPoints, PsaError>,
+) -> Result<Vec<PartScores>, PsaError> {
     let settings = &settings.for_task(task)?;
     if settings.backend != BackendKind::Native {
         return Err(PsaError::Setting(format!(
@@ -294,7 +451,11 @@ pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
         .iter()
         .map(|p| p.rngs.iter().map(|r| r.get_word_pos()).collect())
         .collect();
-    let mut batch = TrialBatch::new(settings, &body)?;
+    let hidden = parts
+        .iter()
+        .flat_map(|p| p.range.clone().map(|j| active_neurons(p.networks, j).count()))
+        .max();
+    let mut batch = TrialBatch::new(settings, &body, hidden.unwrap_or(0))?;
     for part in parts.iter_mut() {
         batch.append(settings, task, part.networks, part.range.clone(), part.rngs)?;
     }
@@ -304,18 +465,18 @@ pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
     let mut first = 0;
     let mut results = Vec::with_capacity(parts.len());
     for (part, positions) in parts.iter_mut().zip(positions) {
-        let mut fitness = Vec::with_capacity(part.range.len());
+        let mut scores = Vec::with_capacity(part.range.len());
         let mut failed = None;
         for (i, j) in part.range.clone().enumerate() {
             let trials = first + i * per..first + (i + 1) * per;
             if flown.finite[trials.clone()].iter().all(|&f| f != 0) {
-                let scores: Vec<f64> = flown.points[trials].iter().map(|p| 100.0 * p / maximum).collect();
-                fitness.push(mean_of_trials(&scores));
+                scores.push(flown.points[trials].iter().map(|p| 100.0 * p / maximum).collect());
             } else {
                 part.rngs[i].set_word_pos(positions[i]);
                 let network = part.networks.network(j);
-                match TrialRunner::new(settings, task).and_then(|mut r| r.evaluate(&network, &mut part.rngs[i])) {
-                    Ok(f) => fitness.push(f),
+                match TrialRunner::new(settings, task).and_then(|mut r| r.evaluate_trials(&network, &mut part.rngs[i]))
+                {
+                    Ok(trial_scores) => scores.push(trial_scores),
                     Err(e) => {
                         failed = Some(e);
                         break;
@@ -324,7 +485,7 @@ pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
             }
         }
         first += part.range.len() * per;
-        results.push(failed.map_or(Ok(fitness), Err));
+        results.push(failed.map_or(Ok(scores), Err));
     }
     Ok(results)
 }
@@ -334,8 +495,18 @@ pub fn evaluate_parts_with<S: NetworkSet + ?Sized>(
 pub trait TrialFlier: Send + Sync + std::fmt::Debug {
     /// Each trial's points and whether it ended finite.
     fn fly(&self, batch: &TrialBatch) -> Result<TrialPoints, PsaError>;
+    /// [`TrialFlier::fly`], with the kernel's own time in seconds where
+    /// the flier measures it (a GPU's events; not the copies).
+    fn fly_timed(&self, batch: &TrialBatch) -> Result<(TrialPoints, Option<f64>), PsaError> {
+        self.fly(batch).map(|points| (points, None))
+    }
     /// What flies them, for the user.
     fn describe(&self) -> String;
+    /// Wall time so far with at least one flight under way, where the
+    /// flier keeps it (a GPU).
+    fn busy(&self) -> Option<std::time::Duration> {
+        None
+    }
 }
 
 /// The kernel built for the host ([`fly_on_host`]) as a [`TrialFlier`]:
@@ -357,55 +528,28 @@ impl TrialFlier for CudaTrials {
     fn fly(&self, batch: &TrialBatch) -> Result<TrialPoints, PsaError> {
         CudaTrials::fly(self, batch)
     }
+    fn fly_timed(&self, batch: &TrialBatch) -> Result<(TrialPoints, Option<f64>), PsaError> {
+        CudaTrials::fly_timed(self, batch).map(|(points, seconds)| (points, Some(seconds)))
+    }
     fn describe(&self) -> String {
         self.device().to_string()
     }
+    fn busy(&self) -> Option<std::time::Duration> {
+        Some(CudaTrials::busy(self))
+    }
 }
 
-/// Flies `batch` with the kernel's code compiled for the host
-/// (`psa-trial-host`, built by `build.rs`), one trial after another: the
-/// GPU's arithmetic on the CPU, for checking the kernel without a GPU.
-pub fn fly_on_host(batch: &TrialBatch) -> Result<TrialPoints, PsaError> {
-    use std::io::Write;
-    use std::process::{Command, Stdio};
-    use zerocopy::IntoBytes;
-    let count = batch.trials.len();
-    let failed = |why: String| PsaError::Setting(format!("the host build of the cuda kernel: {why}"));
-    let header = [
-        i32::try_from(count).map_err(|_| failed(format!("{count} trials are too many")))?,
-        i32::try_from(batch.weights.len()).map_err(|_| failed("too many weights".into()))?,
-    ];
-    let mut input = Vec::new();
-    input.extend_from_slice(header.as_bytes());
-    input.extend_from_slice(batch.params.as_bytes());
-    input.extend_from_slice(batch.weights.as_bytes());
-    input.extend_from_slice(batch.trials.as_bytes());
-    let mut child = Command::new(env!("PSA_ESP_TRIAL_HOST"))
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .map_err(|e| failed(e.to_string()))?;
-    let mut stdin = child.stdin.take().ok_or_else(|| failed("no standard input".into()))?;
-    // Written from a thread of its own, so that a full output pipe cannot
-    // stall the write.
-    let writer = std::thread::spawn(move || stdin.write_all(&input));
-    let output = child.wait_with_output().map_err(|e| failed(e.to_string()))?;
-    writer
-        .join()
-        .map_err(|_| failed("the writer panicked".into()))?
-        .map_err(|e| failed(e.to_string()))?;
-    if !output.status.success() || output.stdout.len() != count * 12 {
-        return Err(failed(format!("it ended with {}", output.status)));
+#[cfg(test)]
+mod tests {
+    use super::hex_float;
+
+    #[test]
+    fn hex_floats_spell_out_every_bit() {
+        assert_eq!(hex_float(1.0), "0x1.0000000000000p+0");
+        assert_eq!(hex_float(-3.0), "-0x1.8000000000000p+1");
+        assert_eq!(hex_float(0.0), "0x0p+0");
+        assert_eq!(hex_float(f64::MIN_POSITIVE), "0x1.0000000000000p-1022");
+        assert_eq!(hex_float(f64::from_bits(1)), "0x0.0000000000001p-1022");
+        assert_eq!(hex_float(std::f64::consts::LN_2), "0x1.62e42fefa39efp-1");
     }
-    let (points, finite) = output.stdout.split_at(count * 8);
-    Ok(TrialPoints {
-        points: points
-            .chunks_exact(8)
-            .map(|b| f64::from_ne_bytes(b.try_into().expect("8 bytes")))
-            .collect(),
-        finite: finite
-            .chunks_exact(4)
-            .map(|b| i32::from_ne_bytes(b.try_into().expect("4 bytes")))
-            .collect(),
-    })
 }

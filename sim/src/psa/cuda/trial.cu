@@ -8,11 +8,46 @@
  * other operation is a separately rounded IEEE operation, as in Rust.
  *
  * Plain C (no C++ features), so that both compilers take it.
+ *
+ * The kernel is specialised at compile time (`cuda::Specialisation` writes
+ * the -D options, the same for NVRTC and the host compiler): the loop
+ * bounds, the discrete settings and the exponential's polynomial are
+ * constants, so that the loops unroll, each thread keeps its network's
+ * weights in registers, and the chains of a step's sigmoids overlap.
+ *
+ *   PSA_HIDDEN            hidden neurons a network of the launch has at most
+ *   PSA_NOISY             any noise configured (the batched kernel's NOISY)
+ *   PSA_INCREMENTAL       fitness: 1 incremental, 0 original
+ *   PSA_SIGNED_SLOWING    the incremental fitness's slowing rule: 1 signed
+ *   PSA_HEADING_ABSOLUTE  the heading input: 1 the heading, 0 the error against the target
+ *   PSA_HEADING_POSITIVE  its wrap range: 1 [0, 2 pi), 0 (-pi, pi]
+ *   PSA_BIAS_NOISE        input noise on the bias too
+ *   PSA_FITNESS_SENSED    the fitness reads the sensed state (the inputs over their scales)
+ *   PSA_FORCE_SUPPORT, PSA_ARM_SUPPORT   per thruster, which components are kept
+ *   PSA_EXP_TERMS, PSA_EXP_Q             the exponential's q, highest first (hex floats)
+ *   PSA_LN2_TERMS, PSA_LN2_PARTS         ln 2 in the parts its argument reduction subtracts
  */
+
+#if !defined(PSA_HIDDEN) || !defined(PSA_NOISY) || !defined(PSA_INCREMENTAL) || !defined(PSA_SIGNED_SLOWING) ||     \
+    !defined(PSA_HEADING_ABSOLUTE) || !defined(PSA_HEADING_POSITIVE) || !defined(PSA_BIAS_NOISE) ||                 \
+    !defined(PSA_FITNESS_SENSED) || !defined(PSA_FORCE_SUPPORT) || !defined(PSA_ARM_SUPPORT) ||                     \
+    !defined(PSA_EXP_TERMS) || !defined(PSA_EXP_Q) || !defined(PSA_LN2_TERMS) || !defined(PSA_LN2_PARTS)
+#error "trial.cu is compiled with its specialisation's -D options (cuda::Specialisation::defines)"
+#endif
+
+/* Threads per block, which __launch_bounds__ promises the compiler. */
+#ifndef PSA_BLOCK
+#define PSA_BLOCK 128
+#endif
+/* Blocks an SM is to hold at once, which bounds the registers a thread gets. */
+#ifndef PSA_MIN_BLOCKS
+#define PSA_MIN_BLOCKS 1
+#endif
 
 #ifdef __CUDACC_RTC__
 #define PSA_FN static __device__ __forceinline__
-#define PSA_CONST static __device__ const
+#define PSA_CONST static __constant__ const
+#define PSA_UNROLL _Pragma("unroll")
 typedef unsigned long long psa_u64;
 #define PSA_BITS(x) ((psa_u64)__double_as_longlong(x))
 #define PSA_FROM_BITS(u) __longlong_as_double((long long)(u))
@@ -22,6 +57,7 @@ typedef unsigned long long psa_u64;
 #include <string.h>
 #define PSA_FN static inline
 #define PSA_CONST static const
+#define PSA_UNROLL
 typedef uint64_t psa_u64;
 static inline psa_u64 psa_bits(double x) {
     psa_u64 u;
@@ -46,7 +82,9 @@ static inline double psa_from_bits(psa_u64 u) {
 #define PSA_SUPPORT_Y 1
 #define PSA_SUPPORT_BOTH 2
 
-/* The settings every thread shares; the Rust side is `cuda::KernelParams` (#[repr(C)]). */
+/* The settings every thread shares, passed by value (the kernel's parameter
+ * space, read through the constant cache); the Rust side is
+ * `cuda::KernelParams` (#[repr(C)]). */
 typedef struct {
     double position_scale, velocity_scale, heading_scale, angular_velocity_scale, bias;
     double input_sd, output_sd;
@@ -54,30 +92,24 @@ typedef struct {
     double force[PSA_THRUSTERS][2];
     double arm[PSA_THRUSTERS][2];
     double inv_mass, inv_inertia_z, dt;
-    double exp_q[10];    /* the exponential's q, highest first: exp_terms of them */
-    double ln2_parts[2]; /* ln 2 in the parts its argument reduction subtracts: ln2_terms of them */
-    int force_support[PSA_THRUSTERS];
-    int arm_support[PSA_THRUSTERS];
     int steps;
-    int noisy;        /* any noise configured (the batched kernel's NOISY) */
-    int incremental;  /* fitness: 1 incremental, 0 original */
-    int signed_slowing;
-    int exp_terms;
-    int ln2_terms;
-    int heading_absolute; /* the heading input: 1 the heading itself, 0 the error against the target */
-    int heading_positive; /* its wrap range: 1 [0, 2 pi), 0 (-pi, pi] */
-    int bias_noise;       /* input noise on the bias too */
-    int fitness_sensed;   /* the fitness reads the sensed state (the inputs over their scales) */
+    int padding;
 } PsaParams;
 
-/* One trial's start and target; the Rust side is `cuda::KernelTrial` (#[repr(C)]). */
+/* One trial's start and target, and its network; the Rust side is
+ * `cuda::KernelTrial` (#[repr(C)]). The noise generator's state, where the
+ * launch is noisy, lies in an array of its own (4 words a trial). */
 typedef struct {
     double position[2], velocity[2], quaternion[2], omega;
     double target[3];
-    psa_u64 noise_state[4];
-    int weights;  /* offset of the network's first gene in the weight array */
-    int hidden;   /* its hidden neurons (lesioned ones left out) */
+    int network; /* its network's row of PSA_HIDDEN neuron indices */
+    int padding;
 } PsaTrial;
+
+PSA_CONST double PSA_EXP_COEFFICIENTS[PSA_EXP_TERMS] = {PSA_EXP_Q};
+PSA_CONST double PSA_LN2[PSA_LN2_TERMS] = {PSA_LN2_PARTS};
+PSA_CONST int PSA_FORCE_SUPPORTS[PSA_THRUSTERS] = {PSA_FORCE_SUPPORT};
+PSA_CONST int PSA_ARM_SUPPORTS[PSA_THRUSTERS] = {PSA_ARM_SUPPORT};
 
 #define PSA_PI 3.141592653589793
 #define PSA_TAU 6.283185307179586
@@ -118,6 +150,7 @@ PSA_CONST double PSA_COS_QUARTER[9] = {
 /* esp_neuroevolution::math::horner: acc = acc * x + c, fused. */
 PSA_FN double psa_horner(double x, const double *c, int n) {
     double acc = c[0];
+    PSA_UNROLL
     for (int i = 1; i < n; i++) acc = fma(acc, x, c[i]);
     return acc;
 }
@@ -128,19 +161,20 @@ PSA_FN double psa_exp2_int(double k) {
     return PSA_FROM_BITS((shifted - PSA_BITS(PSA_TWO_52)) << 52);
 }
 
-/* esp_neuroevolution::math::exp_with, its polynomial and ln 2's parts from the settings */
-PSA_FN double psa_exp(const PsaParams *p, double x) {
+/* esp_neuroevolution::math::exp_with, its polynomial and ln 2's parts those of the specialisation */
+PSA_FN double psa_exp(double x) {
     if (x < -PSA_EXP_LIMIT) x = -PSA_EXP_LIMIT;
     if (PSA_EXP_LIMIT < x) x = PSA_EXP_LIMIT;
     double k = fma(x, PSA_LOG2_E, PSA_ROUNDER) - PSA_ROUNDER;
     double r = x;
-    for (int i = 0; i < p->ln2_terms; i++) r = fma(k, -p->ln2_parts[i], r);
-    double e_r = 1.0 + fma(r * r, psa_horner(r, p->exp_q, p->exp_terms), r);
+    PSA_UNROLL
+    for (int i = 0; i < PSA_LN2_TERMS; i++) r = fma(k, -PSA_LN2[i], r);
+    double e_r = 1.0 + fma(r * r, psa_horner(r, PSA_EXP_COEFFICIENTS, PSA_EXP_TERMS), r);
     return e_r * psa_exp2_int(k);
 }
 
 /* esp_neuroevolution::math::sigmoid_with */
-PSA_FN double psa_sigmoid(const PsaParams *p, double x) { return 1.0 / (1.0 + psa_exp(p, -x)); }
+PSA_FN double psa_sigmoid(double x) { return 1.0 / (1.0 + psa_exp(-x)); }
 
 /* numeric::math::ln, with Real::split_exponent of numeric/mod.rs */
 PSA_FN double psa_ln(double x) {
@@ -251,8 +285,8 @@ PSA_FN void psa_sense(const PsaParams *p, double px, double py, double vx, doubl
                       double tx, double ty, double th, psa_u64 *noise, double *inputs, double *heading_error) {
     double heading = psa_wrap_angle(2.0 * psa_atan2(qz, qw));
     *heading_error = psa_wrap_angle(heading - th);
-    double reading = p->heading_absolute ? psa_wrap_angle(heading) : *heading_error;
-    if (p->heading_positive && reading < 0.0) reading = reading + PSA_TAU;
+    double reading = PSA_HEADING_ABSOLUTE ? psa_wrap_angle(heading) : *heading_error;
+    if (PSA_HEADING_POSITIVE && reading < 0.0) reading = reading + PSA_TAU;
     inputs[0] = (px - tx) * p->position_scale;
     inputs[1] = (py - ty) * p->position_scale;
     inputs[2] = vx * p->velocity_scale;
@@ -260,34 +294,42 @@ PSA_FN void psa_sense(const PsaParams *p, double px, double py, double vx, doubl
     inputs[4] = reading * p->heading_scale;
     inputs[5] = omega * p->angular_velocity_scale;
     inputs[6] = p->bias;
-    if (p->noisy && p->input_sd > 0.0)
-        psa_add_scaled(noise, inputs, p->bias_noise ? PSA_INPUTS : PSA_INPUTS - 1, p->input_sd);
+    if (PSA_NOISY && p->input_sd > 0.0)
+        psa_add_scaled(noise, inputs, PSA_BIAS_NOISE ? PSA_INPUTS : PSA_INPUTS - 1, p->input_sd);
 }
 
-/* One trial: its points; *finite says whether the velocity and spin ended finite. */
-PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial *trial, int *finite) {
+/* One trial of the network whose genes are `genes` (`active` of its PSA_HIDDEN
+ * neurons, the rest unused): its points; *finite says whether the velocity
+ * and spin ended finite. */
+PSA_FN double psa_fly(const PsaParams *p, const double *genes, int active, const PsaTrial *trial, psa_u64 *noise,
+                      int *finite) {
     double px = trial->position[0], py = trial->position[1];
     double vx = trial->velocity[0], vy = trial->velocity[1];
     double qw = trial->quaternion[0], qz = trial->quaternion[1];
     double omega = trial->omega;
     double tx = trial->target[0], ty = trial->target[1], th = trial->target[2];
-    psa_u64 noise[4] = {trial->noise_state[0], trial->noise_state[1], trial->noise_state[2], trial->noise_state[3]};
-    const double *genes = weights + trial->weights;
     double points = 0.0;
     double heading_error;
     double inputs[PSA_INPUTS];
     psa_sense(p, px, py, vx, vy, qw, qz, omega, tx, ty, th, noise, inputs, &heading_error);
     for (int step = 0; step < p->steps; step++) {
         double out[PSA_THRUSTERS] = {0.0, 0.0, 0.0, 0.0};
-        for (int k = 0; k < trial->hidden; k++) {
-            const double *w = genes + k * PSA_GENES;
-            double activation = w[0] * inputs[0];
-            for (int i = 1; i < PSA_INPUTS; i++) activation = fma(w[i], inputs[i], activation);
-            double h = psa_sigmoid(p, activation);
-            for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = fma(h, w[PSA_INPUTS + o], out[o]);
+        PSA_UNROLL
+        for (int k = 0; k < PSA_HIDDEN; k++) {
+            if (k < active) {
+                const double *w = genes + k * PSA_GENES;
+                double activation = w[0] * inputs[0];
+                PSA_UNROLL
+                for (int i = 1; i < PSA_INPUTS; i++) activation = fma(w[i], inputs[i], activation);
+                double h = psa_sigmoid(activation);
+                PSA_UNROLL
+                for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = fma(h, w[PSA_INPUTS + o], out[o]);
+            }
         }
-        for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_sigmoid(p, out[o]);
-        if (p->noisy && p->output_sd > 0.0) psa_add_scaled(noise, out, PSA_THRUSTERS, p->output_sd);
+        PSA_UNROLL
+        for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_sigmoid(out[o]);
+        if (PSA_NOISY && p->output_sd > 0.0) psa_add_scaled(noise, out, PSA_THRUSTERS, p->output_sd);
+        PSA_UNROLL
         for (int o = 0; o < PSA_THRUSTERS; o++) out[o] = psa_clamp_unit(out[o]);
 
         /* PlanarBody::step: accelerate, then the quaternion. */
@@ -296,11 +338,12 @@ PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial 
         double one_minus = 1.0 - two_qz_qz;
         double r00 = one_minus, r01 = 2.0 * -(qw * qz), r10 = 2.0 * (qw * qz), r11 = one_minus;
         double fx = 0.0, fy = 0.0, tau = 0.0;
+        PSA_UNROLL
         for (int t = 0; t < PSA_THRUSTERS; t++) {
             double wf[2], arm[2];
             double u = out[t];
-            psa_rotate(p->force_support[t], r00, r01, r10, r11, p->force[t][0] * u, p->force[t][1] * u, wf);
-            psa_rotate(p->arm_support[t], r00, r01, r10, r11, p->arm[t][0], p->arm[t][1], arm);
+            psa_rotate(PSA_FORCE_SUPPORTS[t], r00, r01, r10, r11, p->force[t][0] * u, p->force[t][1] * u, wf);
+            psa_rotate(PSA_ARM_SUPPORTS[t], r00, r01, r10, r11, p->arm[t][0], p->arm[t][1], arm);
             fx = fx + wf[0];
             fy = fy + wf[1];
             tau = tau + (arm[0] * wf[1] - arm[1] * wf[0]);
@@ -323,22 +366,23 @@ PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial 
         double next[PSA_INPUTS];
         psa_sense(p, px, py, vx, vy, qw, qz, omega, tx, ty, th, noise, next, &heading_error);
         double ex = px - tx, ey = py - ty, fitness_heading = heading_error, fitness_omega = omega;
-        if (p->fitness_sensed) {
+        if (PSA_FITNESS_SENSED) {
             ex = next[0] / p->position_scale;
             ey = next[1] / p->position_scale;
             double sensed_heading = next[4] / p->heading_scale;
-            fitness_heading = psa_wrap_angle(p->heading_absolute ? sensed_heading - th : sensed_heading);
+            fitness_heading = psa_wrap_angle(PSA_HEADING_ABSOLUTE ? sensed_heading - th : sensed_heading);
             fitness_omega = next[5] / p->angular_velocity_scale;
             previous_omega = inputs[5] / p->angular_velocity_scale;
         }
+        PSA_UNROLL
         for (int i = 0; i < PSA_INPUTS; i++) inputs[i] = next[i];
         /* FitnessSettings::points */
         int in_box = fabs(ex) < p->box_half_width && fabs(ey) < p->box_half_width;
         int on_heading = fabs(fitness_heading) < p->heading_window;
         double earned;
-        if (p->incremental) {
+        if (PSA_INCREMENTAL) {
             double spin = fabs(fitness_omega);
-            int slowing = p->signed_slowing ? fitness_omega < previous_omega : spin < fabs(previous_omega);
+            int slowing = PSA_SIGNED_SLOWING ? fitness_omega < previous_omega : spin < fabs(previous_omega);
             int spin_ok = spin < p->spin_window || slowing;
             double full = on_heading ? p->position_points + p->heading_points : p->position_points;
             earned = in_box && spin_ok ? full : 0.0;
@@ -351,17 +395,45 @@ PSA_FN double psa_fly(const PsaParams *p, const double *weights, const PsaTrial 
     return points;
 }
 
+/* Trial i of a launch: its network's genes gathered from `neurons` (PSA_GENES
+ * a neuron) by its row of `networks` (PSA_HIDDEN neuron indices, the active
+ * ones first, -1 after them) into `genes`, its noise state (`noise`, 4 words
+ * a trial, read only where the launch is noisy), and its flight. */
+PSA_FN void psa_trial(const PsaParams *p, const double *neurons, const int *networks, const PsaTrial *trials,
+                      const psa_u64 *noise, int i, double *points, int *finite) {
+    const PsaTrial *trial = &trials[i];
+    const int *row = networks + (long long)trial->network * PSA_HIDDEN;
+    double genes[PSA_HIDDEN * PSA_GENES];
+    int active = 0;
+    PSA_UNROLL
+    for (int k = 0; k < PSA_HIDDEN; k++) {
+        int neuron = row[k];
+        active = neuron >= 0 ? k + 1 : active;
+        PSA_UNROLL
+        for (int g = 0; g < PSA_GENES; g++)
+            genes[k * PSA_GENES + g] = neuron >= 0 ? neurons[(long long)neuron * PSA_GENES + g] : 0.0;
+    }
+    psa_u64 state[4] = {0, 0, 0, 0};
+    if (PSA_NOISY) {
+        PSA_UNROLL
+        for (int w = 0; w < 4; w++) state[w] = noise[4 * (long long)i + w];
+    }
+    points[i] = psa_fly(p, genes, active, trial, state, &finite[i]);
+}
+
 #ifdef __CUDACC_RTC__
-/* One thread per trial; the settings, the weights and the trials lie in device memory. */
-extern "C" __global__ void psa_trials(const PsaParams *params, const double *weights, const PsaTrial *trials,
-                                      int count, double *points, int *finite) {
+/* One thread per trial. */
+extern "C" __global__ void __launch_bounds__(PSA_BLOCK, PSA_MIN_BLOCKS)
+    psa_trials(const PsaParams params, const double *__restrict__ neurons, const int *__restrict__ networks,
+               const PsaTrial *__restrict__ trials, const psa_u64 *__restrict__ noise, int count,
+               double *__restrict__ points, int *__restrict__ finite) {
     int i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i < count) points[i] = psa_fly(params, weights, &trials[i], &finite[i]);
+    if (i < count) psa_trial(&params, neurons, networks, trials, noise, i, points, finite);
 }
 #else
 /* The same trials flown one after another on the host. */
-void psa_trials_host(const PsaParams *params, const double *weights, const PsaTrial *trials, int count, double *points,
-                     int *finite) {
-    for (int i = 0; i < count; i++) points[i] = psa_fly(params, weights, &trials[i], &finite[i]);
+void psa_trials_host(const PsaParams *params, const double *neurons, const int *networks, const PsaTrial *trials,
+                     const psa_u64 *noise, int count, double *points, int *finite) {
+    for (int i = 0; i < count; i++) psa_trial(params, neurons, networks, trials, noise, i, points, finite);
 }
 #endif
