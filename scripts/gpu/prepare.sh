@@ -4,22 +4,23 @@
 # the ODE libraries they load into gpu-build/ (git-ignored), to carry to a
 # machine that has only the NVIDIA driver and NVRTC.
 #   --reference SEEDS  also runs the paper grid's first SEEDS seeds on
-#                      `native` into gpu-build/native, for check.sh to
-#                      compare the GPU's grid with, file for file;
-#   --hashes GRID      also lists the SHA-256 of every file of GRID's
-#                      finished runs but run.json (a `replicate --preset
-#                      paper` grid on `native`, finished or not) in
-#                      gpu-build/paper.sha256, for check.sh to compare the
-#                      whole paper grid on the GPU with.
+#                      `native` into gpu-build/native, and lists its files
+#                      as --hashes does;
+#   --hashes GRID      lists the SHA-256 of every file but run.json of the
+#                      finished runs of GRID (a `replicate --preset paper`
+#                      grid on `native`, finished or not) in
+#                      gpu-build/NAME.sha256 (NAME: GRID's folder name), and
+#                      the arguments that make the same grid in NAME.args,
+#                      for check.sh to make it on the GPU and compare.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seeds=""
-hashes=""
+grids=()
 while [ $# -gt 0 ]; do
     case "$1" in
         --reference) seeds="${2:?--reference needs a seed count}"; shift 2 ;;
-        --hashes) hashes="${2:?--hashes needs a grid folder}"; shift 2 ;;
-        *) echo "usage: scripts/gpu/prepare.sh [--reference SEEDS] [--hashes GRID]" >&2; exit 2 ;;
+        --hashes) grids+=("${2:?--hashes needs a grid folder}"); shift 2 ;;
+        *) echo "usage: scripts/gpu/prepare.sh [--reference SEEDS] [--hashes GRID]..." >&2; exit 2 ;;
     esac
 done
 .ci/install-deps
@@ -40,13 +41,20 @@ done
 if [ -n "$seeds" ]; then
     rm -rf gpu-build/native
     target/release/psa-esp replicate --preset paper --seeds "$seeds" --quiet --out gpu-build/native
+    grids+=(gpu-build/native)
 fi
-if [ -n "$hashes" ]; then
-    grep -q '"preset": "paper"' "$hashes/grid.json" || { echo "$hashes is not a paper-preset grid" >&2; exit 2; }
-    (cd "$hashes" && find runs -name robustness.json -printf '%h\n' | sort |
-        while read -r run; do find "$run" -type f ! -name run.json; done | sort | xargs sha256sum) \
-        > gpu-build/paper.sha256.part
-    mv gpu-build/paper.sha256.part gpu-build/paper.sha256
-    echo "$(wc -l < gpu-build/paper.sha256) files of $(grep -c robustness.json gpu-build/paper.sha256) finished runs listed"
-fi
+for grid in "${grids[@]}"; do
+    name=$(basename "$grid")
+    python3 - "$grid" > "gpu-build/$name.args" <<'PY'
+import json, sys
+grid = json.load(open(sys.argv[1] + "/grid.json"))
+if grid.get("preset") != "paper" or grid.get("backend") != "native" or not grid.get("ode_check"):
+    sys.exit(f"{sys.argv[1]}: not a `replicate --preset paper` grid on native")
+print(f"--preset paper --seeds {grid['seeds']}")
+PY
+    (cd "$grid" && find runs -name robustness.json -printf '%h\n' | sort |
+        while read -r run; do find "$run" -type f ! -name run.json; done | sort | xargs -r sha256sum) \
+        > "gpu-build/$name.sha256"
+    echo "$grid: $(wc -l < "gpu-build/$name.sha256") files of $(grep -c robustness.json "gpu-build/$name.sha256") finished runs listed"
+done
 du -sh gpu-build
