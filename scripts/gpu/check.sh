@@ -6,7 +6,8 @@
 #   timeline.txt   when each step started;
 #   tests.txt      tests/gpu.rs's GPU and NVRTC tests;
 #   bench.txt      the kernel's rows (kernel alone and with copies, beside native);
-#   shapes.txt     the kernel's row at 312,000 networks in other block shapes;
+#   shapes.txt     the kernel's rows at 400 and 312,000 networks in other shapes
+#                  (SHAPES: "threads min-blocks unroll" ...);
 #   grid-NAME.txt  for each gpu-build/NAME.sha256 (smallest first): the
 #                  grid of NAME.args made on `cuda` in the time left, its
 #                  wall time, and the listed files (a native grid's
@@ -32,11 +33,11 @@ done
 echo "$(date +%T) bench" >> "$out/timeline.txt"
 timeout 120 "$bin" bench --kernel-only --rounds 5 > "$out/bench.txt" 2>&1
 echo "$(date +%T) shapes" >> "$out/timeline.txt"
-for shape in "64 1" "32 1" "128 3" "64 6"; do
+for shape in ${SHAPES:-"128 1 1" "128 3 2" "128 4 1" "64 8 1"}; do
     set -- $shape
-    echo "PSA_ESP_CUDA_BLOCK=$1 PSA_ESP_CUDA_MIN_BLOCKS=$2" >> "$out/shapes.txt"
-    PSA_ESP_CUDA_BLOCK=$1 PSA_ESP_CUDA_MIN_BLOCKS=$2 timeout 60 "$bin" bench --kernel-only --rounds 3 \
-        --kernel-networks 312000 >> "$out/shapes.txt" 2>&1
+    echo "PSA_ESP_CUDA_BLOCK=$1 PSA_ESP_CUDA_MIN_BLOCKS=$2 PSA_ESP_CUDA_UNROLL=$3" >> "$out/shapes.txt"
+    PSA_ESP_CUDA_BLOCK=$1 PSA_ESP_CUDA_MIN_BLOCKS=$2 PSA_ESP_CUDA_UNROLL=$3 timeout 60 "$bin" bench --kernel-only \
+        --rounds 3 --kernel-networks 400,312000 >> "$out/shapes.txt" 2>&1
 done
 for list in $(ls -S -r gpu-build/*.sha256 2>/dev/null); do
     name=$(basename "$list" .sha256)
@@ -52,8 +53,8 @@ for list in $(ls -S -r gpu-build/*.sha256 2>/dev/null); do
     echo "exit $?; wall time: $(( $(millis) - start )) ms" >> "$report"
     echo "finished runs: $(find "$scratch/$name/runs" -name robustness.json 2>/dev/null | wc -l)" >> "$report"
     if [ -d "$scratch/$name/runs" ]; then
-        (cd "$scratch/$name" && sha256sum --quiet -c "$OLDPWD/$list") > "$out/grid-$name-differing.txt" 2>&1
-        echo "$(grep -c ': FAILED' "$out/grid-$name-differing.txt") of the $(wc -l < "$list") listed files differ or are missing" >> "$report"
+        scripts/gpu/digest.py "$scratch/$name" --against "$list" > "$out/grid-$name-differing.txt"
+        tail -n 1 "$out/grid-$name-differing.txt" >> "$report"
     else
         echo "no grid written" >> "$report"
     fi

@@ -7,7 +7,7 @@
 #                      `native` into gpu-build/native, and lists its files
 #                      as --hashes does;
 #   --hashes GRID      lists the SHA-256 of every file but run.json of the
-#                      finished runs of GRID (a `replicate --preset paper`
+#                      finished runs of GRID (scripts/gpu/digest.py) (a `replicate --preset paper`
 #                      grid on `native`, finished or not) in
 #                      gpu-build/NAME.sha256 (NAME: GRID's folder name), and
 #                      the arguments that make the same grid in NAME.args,
@@ -52,9 +52,7 @@ if grid.get("preset") != "paper" or grid.get("backend") != "native" or not grid.
     sys.exit(f"{sys.argv[1]}: not a `replicate --preset paper` grid on native")
 print(f"--preset paper --seeds {grid['seeds']}")
 PY
-    (cd "$grid" && find runs -name robustness.json -printf '%h\n' | sort |
-        while read -r run; do find "$run" -type f ! -name run.json; done | sort | xargs -r sha256sum) \
-        > "gpu-build/$name.sha256"
+    scripts/gpu/digest.py "$grid" > "gpu-build/$name.sha256"
     echo "$grid: $(wc -l < "gpu-build/$name.sha256") files of $(grep -c robustness.json "gpu-build/$name.sha256") finished runs listed"
 done
 du -sh gpu-build

@@ -75,18 +75,28 @@ pub const KERNEL_NAME: &str = "psa_trials";
 /// network's weights in registers needs many registers a thread.
 pub const THREADS_PER_BLOCK: u32 = 128;
 
-/// How the kernel is laid out on the device: threads per block, and the
+/// Blocks an SM is to hold at once by default: 128-thread blocks then get
+/// at most 170 registers a thread, 12 warps an SM (on an H100, 0.055 ns per
+/// network-step at 312,000 networks against 0.072 with 181 registers and 8
+/// warps; docs/gpu.md).
+pub const MIN_BLOCKS_PER_SM: u32 = 3;
+
+/// How the kernel is laid out on the device: threads per block, the
 /// blocks an SM is to hold at once (`__launch_bounds__`' second number,
-/// which caps the registers a thread gets). It changes speed only, never a
-/// result. The defaults, unless the environment sets
-/// `PSA_ESP_CUDA_BLOCK` or `PSA_ESP_CUDA_MIN_BLOCKS` (for tuning on a
-/// new device; see docs/gpu.md).
+/// which caps the registers a thread gets), and how many steps of a trial
+/// one pass of its loop flies (the unrolling lets a step's fitness overlap
+/// the next step). It changes speed only, never a result. The defaults,
+/// unless the environment sets `PSA_ESP_CUDA_BLOCK`,
+/// `PSA_ESP_CUDA_MIN_BLOCKS` or `PSA_ESP_CUDA_UNROLL` (for tuning on a new
+/// device; see docs/gpu.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct KernelShape {
     /// Threads per block.
     pub block: u32,
     /// Blocks an SM is to hold at once.
     pub min_blocks: u32,
+    /// Steps a pass of the trial's loop.
+    pub unroll: u32,
 }
 
 impl KernelShape {
@@ -107,16 +117,18 @@ impl KernelShape {
         }
         Ok(KernelShape {
             block,
-            min_blocks: read("PSA_ESP_CUDA_MIN_BLOCKS", 1, 32)?,
+            min_blocks: read("PSA_ESP_CUDA_MIN_BLOCKS", MIN_BLOCKS_PER_SM, 32)?,
+            unroll: read("PSA_ESP_CUDA_UNROLL", 1, 8)?,
         })
     }
 
     /// Its `-D` options.
     #[cfg_attr(not(feature = "cuda"), allow(dead_code))]
-    fn defines(self) -> [String; 2] {
+    fn defines(self) -> [String; 3] {
         [
             format!("-DPSA_BLOCK={}", self.block),
             format!("-DPSA_MIN_BLOCKS={}", self.min_blocks),
+            format!("-DPSA_STEP_UNROLL={}", self.unroll),
         ]
     }
 }
@@ -125,8 +137,8 @@ impl fmt::Display for KernelShape {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} threads a block, at least {} blocks an SM",
-            self.block, self.min_blocks
+            "{} threads a block, at least {} blocks an SM, {} step(s) a pass",
+            self.block, self.min_blocks, self.unroll
         )
     }
 }
@@ -134,7 +146,8 @@ impl fmt::Display for KernelShape {
 #[cfg(feature = "cuda")]
 mod gpu {
     use std::collections::HashMap;
-    use std::sync::{Arc, Mutex, OnceLock};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{Arc, Mutex, OnceLock, RwLock};
     use std::time::{Duration, Instant};
 
     use cudarc::driver::sys::CUevent_flags;
@@ -204,8 +217,9 @@ mod gpu {
         compile_ptx_with_opts(KERNEL_SOURCE, options).map_err(|e| CudaUnavailable::Compile(e.to_string()))
     }
 
-    /// A compiled kernel, shared by the threads that ask for it at once.
-    type Compiled = Arc<OnceLock<Result<CudaFunction, String>>>;
+    /// A compiled kernel, shared by the threads that ask for it at once,
+    /// and whether it has been launched yet.
+    type Compiled = Arc<(OnceLock<Result<CudaFunction, String>>, AtomicBool)>;
 
     /// The kernel on one device, ready to fly batches.
     pub struct Loaded {
@@ -217,6 +231,10 @@ mod gpu {
         kernels: Mutex<HashMap<String, Compiled>>,
         /// Slots not in use; a launch takes one (or makes one) and gives it back.
         slots: Mutex<Vec<Slot>>,
+        /// Held shared by every launch in flight, and alone by a kernel's
+        /// loading and first launch (which may resize the device's local
+        /// memory): no module is loaded or first run beside other work.
+        launches: RwLock<()>,
         /// Wall time with at least one launch in flight.
         busy: Mutex<Busy>,
     }
@@ -270,17 +288,12 @@ mod gpu {
             shape,
             kernels: Mutex::new(HashMap::new()),
             slots: Mutex::new(Vec::new()),
+            launches: RwLock::new(()),
             busy: Mutex::new(Busy::default()),
         };
-        loaded.kernel(check).map_err(|e| match e {
-            KernelError::Compile(e) | KernelError::Driver(e) => e,
-        })?;
+        let entry = loaded.entry(check).map_err(driver)?;
+        loaded.load(&entry, check)?;
         Ok(loaded)
-    }
-
-    enum KernelError {
-        Compile(CudaUnavailable),
-        Driver(CudaUnavailable),
     }
 
     /// A launch's buffers: a stream, page-locked host memory for the
@@ -353,29 +366,36 @@ mod gpu {
     }
 
     impl Loaded {
-        /// The kernel of `specialisation`, compiled and loaded when first asked for.
-        fn kernel(&self, specialisation: &Specialisation) -> Result<CudaFunction, KernelError> {
-            let compiled = self
+        /// The entry of `specialisation`'s kernel (compiled or not yet).
+        fn entry(&self, specialisation: &Specialisation) -> Result<Compiled, PsaError> {
+            Ok(self
                 .kernels
                 .lock()
-                .map_err(|_| KernelError::Driver(driver("a compilation panicked")))?
+                .map_err(|_| failed("a compilation panicked"))?
                 .entry(specialisation.key())
                 .or_default()
-                .clone();
-            let function = compiled.get_or_init(|| {
-                let ptx =
-                    compile(specialisation, self.shape, Some(self.architecture.clone())).map_err(|e| e.to_string())?;
-                let module = self.context.load_module(ptx).map_err(|e| e.to_string())?;
-                module.load_function(KERNEL_NAME).map_err(|e| e.to_string())
-            });
-            function
+                .clone())
+        }
+
+        /// The kernel of `entry` (of `specialisation`), compiled and loaded
+        /// when first asked for.
+        fn load(&self, entry: &Compiled, specialisation: &Specialisation) -> Result<CudaFunction, CudaUnavailable> {
+            entry
+                .0
+                .get_or_init(|| {
+                    let ptx = compile(specialisation, self.shape, Some(self.architecture.clone()))
+                        .map_err(|e| e.to_string())?;
+                    let module = self.context.load_module(ptx).map_err(|e| e.to_string())?;
+                    module.load_function(KERNEL_NAME).map_err(|e| e.to_string())
+                })
                 .clone()
-                .map_err(|why| KernelError::Compile(CudaUnavailable::Compile(why)))
+                .map_err(CudaUnavailable::Compile)
         }
 
         /// Flies every trial of `batch`, one thread each: the points, and
         /// the kernel's own time in seconds (CUDA events; the copies not
-        /// included).
+        /// included). A kernel's loading and first launch have the device
+        /// to themselves; every other launch runs beside the others.
         pub fn fly(&self, batch: &TrialBatch) -> Result<(TrialPoints, f64), PsaError> {
             if batch.trials.is_empty() {
                 let none = TrialPoints {
@@ -384,16 +404,34 @@ mod gpu {
                 };
                 return Ok((none, 0.0));
             }
-            let function = self.kernel(&batch.specialisation).map_err(|e| match e {
-                KernelError::Compile(e) | KernelError::Driver(e) => failed(e),
-            })?;
+            let entry = self.entry(&batch.specialisation)?;
+            let flown = if entry.1.load(Ordering::Acquire) {
+                let _shared = self.launches.read().map_err(|_| failed("a launch panicked"))?;
+                let function = self.load(&entry, &batch.specialisation).map_err(failed)?;
+                self.fly_in_slot(&function, batch)
+            } else {
+                let _alone = self.launches.write().map_err(|_| failed("a launch panicked"))?;
+                let function = self.load(&entry, &batch.specialisation).map_err(failed)?;
+                let flown = self.fly_in_slot(&function, batch);
+                entry.1.store(true, Ordering::Release);
+                flown
+            };
+            flown.map_err(|e| {
+                let count = batch.trials.len();
+                let key = batch.specialisation.key();
+                PsaError::Setting(format!("{e} (a launch of {count} trials, specialisation {key})"))
+            })
+        }
+
+        /// [`Loaded::fly`] on a slot of the pool (or a new one).
+        fn fly_in_slot(&self, function: &CudaFunction, batch: &TrialBatch) -> Result<(TrialPoints, f64), PsaError> {
             let taken = self.slots.lock().map_err(|_| failed("a launch panicked"))?.pop();
             let mut slot = match taken {
                 Some(slot) => slot,
                 None => Slot::new(&self.context)?,
             };
             self.count_busy(true);
-            let flown = self.fly_in(&mut slot, &function, batch);
+            let flown = self.fly_in(&mut slot, function, batch);
             self.count_busy(false);
             self.slots.lock().map_err(|_| failed("a launch panicked"))?.push(slot);
             flown

@@ -43,6 +43,16 @@
 #ifndef PSA_MIN_BLOCKS
 #define PSA_MIN_BLOCKS 1
 #endif
+/* Steps a pass of a trial's loop (the GPU's unrolling; no result depends on it). */
+#ifndef PSA_STEP_UNROLL
+#define PSA_STEP_UNROLL 1
+#endif
+#ifdef __CUDACC_RTC__
+#define PSA_PRAGMA(x) _Pragma(#x)
+#define PSA_UNROLL_STEPS(n) PSA_PRAGMA(unroll n)
+#else
+#define PSA_UNROLL_STEPS(n)
+#endif
 
 #ifdef __CUDACC_RTC__
 #define PSA_FN static __device__ __forceinline__
@@ -312,6 +322,7 @@ PSA_FN double psa_fly(const PsaParams *p, const double *genes, int active, const
     double heading_error;
     double inputs[PSA_INPUTS];
     psa_sense(p, px, py, vx, vy, qw, qz, omega, tx, ty, th, noise, inputs, &heading_error);
+    PSA_UNROLL_STEPS(PSA_STEP_UNROLL)
     for (int step = 0; step < p->steps; step++) {
         double out[PSA_THRUSTERS] = {0.0, 0.0, 0.0, 0.0};
         PSA_UNROLL
