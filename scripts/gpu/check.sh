@@ -7,7 +7,7 @@
 #   tests.txt      tests/gpu.rs's GPU and NVRTC tests;
 #   bench.txt      the kernel's rows (kernel alone and with copies, beside native);
 #   shapes.txt     the kernel's rows at 400 and 312,000 networks in other shapes
-#                  (SHAPES: "threads min-blocks unroll" ...);
+#                  (SHAPES: "threads min-blocks unroll;..." ...);
 #   grid-NAME.txt  for each gpu-build/NAME.sha256 (smallest first): the
 #                  grid of NAME.args made on `cuda` in the time left, its
 #                  wall time, and the listed files (a native grid's
@@ -33,7 +33,9 @@ done
 echo "$(date +%T) bench" >> "$out/timeline.txt"
 timeout 120 "$bin" bench --kernel-only --rounds 5 > "$out/bench.txt" 2>&1
 echo "$(date +%T) shapes" >> "$out/timeline.txt"
-for shape in ${SHAPES:-"128 1 1" "128 3 2" "128 4 1" "64 8 1"}; do
+IFS=';' read -ra shapes <<< "${SHAPES:-128 1 1;128 3 2;128 4 1;64 8 1}"
+for shape in "${shapes[@]}"; do
+    # shellcheck disable=SC2086
     set -- $shape
     echo "PSA_ESP_CUDA_BLOCK=$1 PSA_ESP_CUDA_MIN_BLOCKS=$2 PSA_ESP_CUDA_UNROLL=$3" >> "$out/shapes.txt"
     PSA_ESP_CUDA_BLOCK=$1 PSA_ESP_CUDA_MIN_BLOCKS=$2 PSA_ESP_CUDA_UNROLL=$3 timeout 60 "$bin" bench --kernel-only \

@@ -272,8 +272,11 @@ pub fn run(args: ReplicateArgs) -> Result<i32> {
     let spec = args.grid.spec()?;
     let progress = Progress::new(args.grid.quiet, false);
     let options = args.grid.options()?;
-    let summary = replicate(&args.out, &spec, &options, &progress)?;
+    let clock = Instant::now();
+    let summary = replicate(&args.out, &spec, &options, &progress);
     progress.bar.finish_and_clear();
+    report_gpu_share(&options.eval_path, clock.elapsed().as_secs_f64())?;
+    let summary = summary?;
     report_held(summary.held.iter().map(|h| (String::new(), h)));
     let shard = if options.shard == Shard::ALL {
         String::new()
@@ -290,13 +293,13 @@ pub fn run(args: ReplicateArgs) -> Result<i32> {
         summary.held.len(),
         summary.seconds
     );
-    report_gpu_share(&options.eval_path, summary.seconds)?;
     say!("next: psa-esp report {}", args.out.display());
     Ok(0)
 }
 
 /// With `--backend cuda`, the wall time the GPU evaluated (a launch in
-/// flight, its copies included) of the grid's `seconds`.
+/// flight, its copies included) of the command's `seconds` (printed
+/// whether or not its runs all succeeded).
 pub fn report_gpu_share(path: &EvalPath, seconds: f64) -> Result<()> {
     if let EvalPath::Kernel(flier) = path {
         if let Some(busy) = flier.busy() {

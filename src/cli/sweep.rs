@@ -34,8 +34,11 @@ pub fn run(args: SweepArgs) -> Result<i32> {
     let spec = SweepSpec::new(args.grid.spec()?, vary, args.mode)?;
     let progress = Progress::new(args.grid.quiet, true);
     let options = args.grid.options()?;
-    let summary = sweep(&args.out, &spec, &options, &progress)?;
+    let clock = std::time::Instant::now();
+    let summary = sweep(&args.out, &spec, &options, &progress);
     progress.bar.finish_and_clear();
+    report_gpu_share(&options.eval_path, clock.elapsed().as_secs_f64())?;
+    let summary = summary?;
     report_held(summary.held.iter().map(|(variant, h)| (format!("{variant}: "), h)));
     say!(
         "sweep {}: {} variants, {} runs, {} already finished, {} run now, {} left to other processes, in {:.0} s",
@@ -47,7 +50,6 @@ pub fn run(args: SweepArgs) -> Result<i32> {
         summary.held.len(),
         summary.seconds
     );
-    report_gpu_share(&options.eval_path, summary.seconds)?;
     say!("next: psa-esp report {}", args.out.display());
     Ok(0)
 }

@@ -76,10 +76,11 @@ pub const KERNEL_NAME: &str = "psa_trials";
 pub const THREADS_PER_BLOCK: u32 = 128;
 
 /// Blocks an SM is to hold at once by default: 128-thread blocks then get
-/// at most 170 registers a thread, 12 warps an SM (on an H100, 0.055 ns per
-/// network-step at 312,000 networks against 0.072 with 181 registers and 8
+/// at most 128 registers a thread (some spilled to the L1 cache), 16 warps
+/// an SM; on an H100 0.048 ns per network-step at 312,000 networks against
+/// 0.055 at 3 blocks (168 registers) and 0.072 at 1 (181 registers, 8
 /// warps; docs/gpu.md).
-pub const MIN_BLOCKS_PER_SM: u32 = 3;
+pub const MIN_BLOCKS_PER_SM: u32 = 4;
 
 /// How the kernel is laid out on the device: threads per block, the
 /// blocks an SM is to hold at once (`__launch_bounds__`' second number,
