@@ -103,10 +103,18 @@ pub struct KernelShape {
 impl KernelShape {
     /// The defaults, or the environment's values.
     pub fn from_env() -> Result<KernelShape, String> {
+        KernelShape::from_values(|name| std::env::var(name).ok())
+    }
+
+    /// The shape that `value` gives each variable (`PSA_ESP_CUDA_BLOCK`,
+    /// `PSA_ESP_CUDA_MIN_BLOCKS`, `PSA_ESP_CUDA_UNROLL`), the default where
+    /// it gives none; an error naming a variable whose value is not a
+    /// whole number in its range (or, for the block, a multiple of 32).
+    pub fn from_values(value: impl Fn(&str) -> Option<String>) -> Result<KernelShape, String> {
         let read = |name: &str, default: u32, most: u32| -> Result<u32, String> {
-            match std::env::var(name) {
-                Err(_) => Ok(default),
-                Ok(text) => match text.parse::<u32>() {
+            match value(name) {
+                None => Ok(default),
+                Some(text) => match text.parse::<u32>() {
                     Ok(value) if (1..=most).contains(&value) => Ok(value),
                     _ => Err(format!("{name}={text:?}: expected a whole number from 1 to {most}")),
                 },
@@ -651,5 +659,50 @@ pub fn compile_for_check() -> Result<String, CudaUnavailable> {
     #[cfg(not(feature = "cuda"))]
     {
         Err(CudaUnavailable::NotBuilt)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{KernelShape, MIN_BLOCKS_PER_SM, THREADS_PER_BLOCK};
+
+    fn shape(pairs: &[(&str, &str)]) -> Result<KernelShape, String> {
+        KernelShape::from_values(|name| {
+            pairs
+                .iter()
+                .find(|(key, _)| *key == name)
+                .map(|(_, value)| value.to_string())
+        })
+    }
+
+    #[test]
+    fn the_kernel_shape_takes_valid_values_and_names_a_bad_one() {
+        let default = shape(&[]).unwrap();
+        assert_eq!(
+            (default.block, default.min_blocks, default.unroll),
+            (THREADS_PER_BLOCK, MIN_BLOCKS_PER_SM, 1)
+        );
+        let set = shape(&[
+            ("PSA_ESP_CUDA_BLOCK", "64"),
+            ("PSA_ESP_CUDA_MIN_BLOCKS", "8"),
+            ("PSA_ESP_CUDA_UNROLL", "2"),
+        ]);
+        assert_eq!(
+            set.unwrap(),
+            KernelShape {
+                block: 64,
+                min_blocks: 8,
+                unroll: 2
+            }
+        );
+        for (name, bad) in [
+            ("PSA_ESP_CUDA_BLOCK", "100"),
+            ("PSA_ESP_CUDA_BLOCK", "2048"),
+            ("PSA_ESP_CUDA_MIN_BLOCKS", "0"),
+            ("PSA_ESP_CUDA_UNROLL", "two"),
+        ] {
+            let error = shape(&[(name, bad)]).unwrap_err();
+            assert!(error.contains(name), "{error}");
+        }
     }
 }
