@@ -17,7 +17,6 @@ use rayon::prelude::*;
 
 use super::grid::{run_dir, GridSpec, RunKey};
 use super::grid_run::{run_seed, test_and_mark, FinishedRun};
-use super::replicate::GridJob;
 use super::{Algorithm, GridConfig, RunConfig, RunStart};
 use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::lockstep::lockstep_with;
@@ -68,12 +67,13 @@ struct Started {
 /// An evaluator of one grid's configuration and task.
 type CellEvaluator = ((usize, GridConfig, Task), PsaEvaluator);
 
-/// Runs `todo` (each a run of one of `grids`, by index) in lockstep on the
-/// current rayon pool, their networks evaluated on `path`: every grid's
-/// runs in one pass. Hands each run's outcome to `finished` with its
-/// grid's index, as [`crate::grid_run::run_one`] would give it.
+/// Runs `todo` (each a run of one of `grids`, a folder and its definition,
+/// by index) in lockstep on the current rayon pool, their networks
+/// evaluated on `path`: every grid's runs in one pass. Hands each run's
+/// outcome to `finished` with its grid's index, as
+/// [`crate::grid_run::run_one`] would give it.
 pub(super) fn replicate_lockstep(
-    grids: &[GridJob],
+    grids: &[(&Path, &GridSpec)],
     todo: &[(usize, RunKey)],
     path: &EvalPath,
     finished: &(dyn Fn(usize, Result<FinishedRun>) + Sync),
@@ -82,8 +82,9 @@ pub(super) fn replicate_lockstep(
     let mut started = Vec::new();
     let mut runs: Vec<AnyRun> = Vec::new();
     for &(grid, key) in todo {
-        let folder = run_dir(grids[grid].dir, &key);
-        match begin(grids[grid].spec, grid, &key, &folder, path, &mut evaluators) {
+        let (dir, spec) = grids[grid];
+        let folder = run_dir(dir, &key);
+        match begin(spec, grid, &key, &folder, path, &mut evaluators) {
             Ok((run, search)) => {
                 started.push(run);
                 runs.push(search);
@@ -94,7 +95,7 @@ pub(super) fn replicate_lockstep(
     let which: Vec<&PsaEvaluator> = started.iter().map(|s| &evaluators[s.evaluator].1).collect();
     let folders: Vec<PathBuf> = started
         .iter()
-        .map(|s| run_dir(grids[s.grid].dir, &s.key).join(CHECKPOINT))
+        .map(|s| run_dir(grids[s.grid].0, &s.key).join(CHECKPOINT))
         .collect();
     let live: Vec<Mutex<&mut RunStart>> = started.iter_mut().map(|s| Mutex::new(&mut s.start)).collect();
     let on_record = |run: usize, record: &_| {
@@ -121,7 +122,7 @@ pub(super) fn replicate_lockstep(
         .zip(errors)
         .with_max_len(1)
         .for_each(|((run, search), error)| {
-            let GridJob { dir, spec, .. } = grids[run.grid];
+            let (dir, spec) = grids[run.grid];
             let folder = run_dir(dir, &run.key);
             let outcome = match error {
                 Some(e) => Err(e.into()),

@@ -285,7 +285,8 @@ pub fn replicate_grids(
                     mine.push(*run);
                 }
             }
-            replicate_lockstep(grids, &mine, &options.eval_path, &finished);
+            let folders: Vec<(&Path, &GridSpec)> = grids.iter().map(|g| (g.dir, g.spec)).collect();
+            replicate_lockstep(&folders, &mine, &options.eval_path, &finished);
             drop(claims);
         }
     });
