@@ -248,6 +248,11 @@ fn active_neurons<S: NetworkSet + ?Sized>(networks: &S, j: usize) -> impl Iterat
     (0..networks.hidden(j)).filter(move |&k| !networks.is_lesioned(j, k))
 }
 
+/// The most active hidden neurons of networks `range` of `networks` (0 for none).
+fn widest<S: NetworkSet + ?Sized>(networks: &S, range: std::ops::Range<usize>) -> usize {
+    range.map(|j| active_neurons(networks, j).count()).max().unwrap_or(0)
+}
+
 /// The batch for networks `range` of `networks` on `task`, drawing each
 /// trial's start and noise seed from `rngs[i]` for network `range.start + i`
 /// in the scalar path's order.
@@ -262,8 +267,7 @@ pub fn prepare<S: NetworkSet + ?Sized>(
     range: std::ops::Range<usize>,
     rngs: &mut [Stream],
 ) -> Result<TrialBatch, PsaError> {
-    let hidden = range.clone().map(|j| active_neurons(networks, j).count()).max();
-    let mut batch = TrialBatch::new(settings, body, hidden.unwrap_or(0))?;
+    let mut batch = TrialBatch::new(settings, body, widest(networks, range.clone()))?;
     batch.append(settings, task, networks, range, rngs)?;
     Ok(batch)
 }
@@ -451,10 +455,7 @@ fn trial_scores_of_parts<S: NetworkSet + ?Sized>(
         .iter()
         .map(|p| p.rngs.iter().map(|r| r.get_word_pos()).collect())
         .collect();
-    let hidden = parts
-        .iter()
-        .flat_map(|p| p.range.clone().map(|j| active_neurons(p.networks, j).count()))
-        .max();
+    let hidden = parts.iter().map(|p| widest(p.networks, p.range.clone())).max();
     let mut batch = TrialBatch::new(settings, &body, hidden.unwrap_or(0))?;
     for part in parts.iter_mut() {
         batch.append(settings, task, part.networks, part.range.clone(), part.rngs)?;
