@@ -2,7 +2,7 @@
 
 use psa_esp::physics::{
     create_backend, crosscheck, random_thrust_sequence, tolerance, trajectory, BackendKind, BodyState, Deviation,
-    PlaneConstraint, StepSettings, Stepper,
+    PlaneConstraint, StartQuaternion, StepSettings, Stepper,
 };
 use psa_esp::psa::BodySettings;
 
@@ -90,4 +90,51 @@ fn quick_step_agrees_with_the_exact_stepper() {
     };
     let (worst, _) = max_deviation(exact, quick, 10);
     assert!(worst.within(&tolerance(BackendKind::Native)), "{worst:?}");
+}
+
+/// The start states of `native` and `ode` from `heading`, as each backend
+/// keeps them (quaternion included).
+fn start_quaternions(settings: &StepSettings, heading: f64) -> ([f64; 2], [f64; 2]) {
+    let model = BodySettings::default().model().unwrap();
+    let start = BodyState {
+        heading,
+        omega: 0.5,
+        ..BodyState::default()
+    };
+    let mut quaternions = [[0.0; 2]; 2];
+    for (q, kind) in quaternions.iter_mut().zip([BackendKind::Native, BackendKind::Ode]) {
+        let mut backend = create_backend(kind, &model, settings).unwrap();
+        backend.reset(&start).unwrap();
+        *q = backend.planar_state().quaternion;
+    }
+    (quaternions[0], quaternions[1])
+}
+
+#[test]
+fn native_starts_from_the_quaternion_ode_sets_on_any_heading() {
+    // 2000 headings spread over a turn by an irrational step, off the
+    // round values the tasks use.
+    let step = std::f64::consts::TAU / (2000.0 * std::f64::consts::SQRT_2);
+    let headings: Vec<f64> = (0..2000).map(|k| -3.0 + step * f64::from(k) * 1.4).collect();
+    for &h in &headings {
+        let (native, ode) = start_quaternions(&StepSettings::default(), h);
+        assert_eq!(native.map(f64::to_bits), ode.map(f64::to_bits), "heading {h}");
+    }
+    // The earlier, raw quaternion is (cos h/2, sin h/2) as computed, and
+    // ODE's normalisation moves it for a good share of these headings.
+    let raw = StepSettings {
+        start_quaternion: StartQuaternion::Raw,
+        ..StepSettings::default()
+    };
+    let mut moved = 0;
+    for &h in &headings {
+        let (native, ode) = start_quaternions(&raw, h);
+        assert_eq!(native, [(0.5 * h).cos(), (0.5 * h).sin()]);
+        moved += usize::from(native != ode);
+    }
+    assert!(
+        moved > headings.len() / 20,
+        "ODE moved only {moved} of {} start quaternions",
+        headings.len()
+    );
 }

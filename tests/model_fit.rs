@@ -74,36 +74,42 @@ fn doing_nothing_scores_under_1_percent_on_task_2_and_a_few_on_tasks_1_and_3() {
 /// in `tests/golden/GOLDEN/PRESET-tTASK.csv` on every task, byte for byte
 /// (seed 7, 120 generations, native).
 fn assert_repeats_the_golden_records(config: &str, golden: &str, presets: &[&str]) {
-    let dir = tempfile::tempdir().unwrap();
-    let config = repo(config);
     for preset in presets {
         for task in ["1", "2", "3"] {
-            let out = dir.path().join(format!("{preset}-t{task}"));
-            ok(&psa_esp(&[
-                "evolve",
-                "--task",
-                task,
-                "--preset",
-                preset,
-                "--seed",
-                "7",
-                "--generations",
-                "120",
-                "--backend",
-                "native",
-                "--config",
-                config.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ]));
-            let recorded = std::fs::read(repo(&format!("tests/golden/{golden}/{preset}-t{task}.csv"))).unwrap();
-            let records = std::fs::read(out.join("records.csv")).unwrap();
-            assert!(
-                records == recorded,
-                "{preset} task {task}: records.csv differs from the one recorded in tests/golden/{golden}"
-            );
+            assert_repeats_one_golden_record(&repo(config), golden, preset, preset, task);
         }
     }
+}
+
+/// Asserts that `config` laid over `preset` repeats the records in
+/// `tests/golden/GOLDEN/LABEL-tTASK.csv` on `task`, byte for byte (seed 7,
+/// 120 generations, native).
+fn assert_repeats_one_golden_record(config: &Path, golden: &str, preset: &str, label: &str, task: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    ok(&psa_esp(&[
+        "evolve",
+        "--task",
+        task,
+        "--preset",
+        preset,
+        "--seed",
+        "7",
+        "--generations",
+        "120",
+        "--backend",
+        "native",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let recorded = std::fs::read(repo(&format!("tests/golden/{golden}/{label}-t{task}.csv"))).unwrap();
+    let records = std::fs::read(out.join("records.csv")).unwrap();
+    assert!(
+        records == recorded,
+        "{label} task {task}: records.csv differs from the one recorded in tests/golden/{golden}"
+    );
 }
 
 #[test]
@@ -124,6 +130,26 @@ fn the_fitted_incremental_file_repeats_the_records_of_the_model_before_the_readi
         "fitted-incremental",
         &["baseline", "max-credit"],
     );
+}
+
+#[test]
+fn the_scored_on_original_file_repeats_the_records_of_the_first_original_scoring_grid_byte_for_byte() {
+    // Recorded by build 030dd52, whose defaults the file pins; evolution
+    // from random starts too.
+    let config = "configs/scored-on-original.toml";
+    assert_repeats_the_golden_records(config, "scored-on-original", &["baseline", "max-credit"]);
+    let dir = tempfile::tempdir().unwrap();
+    let random_starts = dir.path().join("random-starts.toml");
+    let text = std::fs::read_to_string(repo(config)).unwrap();
+    assert!(text.contains("\n[problem]\n"), "{config} has no [problem] table");
+    std::fs::write(
+        &random_starts,
+        text.replace("\n[problem]\n", "\n[problem]\nrandom_init = true\n"),
+    )
+    .unwrap();
+    for task in ["1", "3"] {
+        assert_repeats_one_golden_record(&random_starts, "scored-on-original", "baseline", "random-init", task);
+    }
 }
 
 #[test]

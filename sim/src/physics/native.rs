@@ -11,8 +11,8 @@
 //! planar spin about a principal axis, as here.
 
 use super::{
-    validate_thrust, BackendKind, BodyState, MassProperties, PhysicsBackend, PhysicsError, RigidBodyModel, StepGuard,
-    StepSettings,
+    validate_thrust, BackendKind, BodyState, MassProperties, PhysicsBackend, PhysicsError, RigidBodyModel,
+    StartQuaternion, StepGuard, StepSettings,
 };
 use crate::numeric::{atan2, wrap_angle, Real};
 
@@ -131,6 +131,7 @@ pub struct PlanarBody {
     inv_mass: f64,
     inv_inertia_z: f64,
     dt: f64,
+    start_quaternion: StartQuaternion,
 }
 
 /// The planar state as ODE keeps it: position and velocity of the centre of
@@ -151,13 +152,30 @@ pub struct PlanarState<R> {
 }
 
 impl PlanarState<f64> {
-    /// The state of `state`: the quaternion of its heading, (cos h/2, sin h/2).
+    /// The state of `state` as ODE sets it: the quaternion of its heading,
+    /// (cos h/2, sin h/2), scaled to unit length as `dBodySetQuaternion`
+    /// scales it.
     pub fn from_body_state(state: &BodyState) -> Self {
+        Self::start(state, StartQuaternion::Normalised)
+    }
+
+    /// The state of `state` with its heading's quaternion made by `rule`.
+    pub fn start(state: &BodyState, rule: StartQuaternion) -> Self {
         let half = 0.5 * state.heading;
+        let (w, z) = (half.cos(), half.sin());
+        let quaternion = match rule {
+            // dxSafeNormalize4: the squares summed in order (x and y are 0),
+            // one division of 1 by the square root, four products.
+            StartQuaternion::Normalised => {
+                let scale = 1.0 / (w * w + z * z).sqrt();
+                [w * scale, z * scale]
+            }
+            StartQuaternion::Raw => [w, z],
+        };
         PlanarState {
             position: [state.x, state.y],
             velocity: [state.vx, state.vy],
-            quaternion: [half.cos(), half.sin()],
+            quaternion,
             omega: state.omega,
         }
     }
@@ -212,7 +230,14 @@ impl PlanarBody {
             inv_mass: 1.0 / properties.mass,
             inv_inertia_z: 1.0 / properties.inertia[2][2],
             dt: settings.dt,
+            start_quaternion: settings.start_quaternion,
         })
+    }
+
+    /// The state a trial from `state` starts in, its quaternion made as the
+    /// settings say ([`StartQuaternion`]).
+    pub fn start_state(&self, state: &BodyState) -> PlanarState<f64> {
+        PlanarState::start(state, self.start_quaternion)
     }
 
     /// Number of thrusters.
@@ -334,7 +359,7 @@ impl PhysicsBackend for NativeBackend {
 
     fn reset(&mut self, state: &BodyState) -> Result<(), PhysicsError> {
         state.validate()?;
-        let state = PlanarState::from_body_state(state);
+        let state = self.body.start_state(state);
         self.guard.check(&state)?;
         self.state = state;
         Ok(())

@@ -516,7 +516,7 @@ impl BatchRunner {
             for (lane, rng) in rngs.iter_mut().enumerate() {
                 let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
                 start.validate()?;
-                starts[lane] = PlanarState::from_body_state(&start);
+                starts[lane] = self.body.start_state(&start);
                 targets[lane] = [target.x, target.y, target.heading];
                 seeds[lane] = s.noise.draw_seed(rng);
             }

@@ -333,7 +333,7 @@ impl TrialBatch {
             for _ in 0..settings.trials {
                 let (start, target) = settings.tasks.start_and_target(task, settings.random_init, rng);
                 start.validate()?;
-                let state = PlanarState::from_body_state(&start);
+                let state = PlanarState::start(&start, settings.physics.start_quaternion);
                 self.trials.push(KernelTrial {
                     position: state.position,
                     velocity: state.velocity,
