@@ -225,7 +225,12 @@ fn runs_csv_and_the_json_files_keep_every_seed_exact() {
         let summary: serde_json::Value =
             serde_json::from_slice(&std::fs::read(folder.join("run.json")).unwrap()).unwrap();
         assert_eq!(summary["seed"], serde_json::Value::String(seed.to_string()));
-        assert_eq!(row[col("champion_fitness")], summary["champion_fitness"].to_string());
+        // The same number exactly (the CSV may write 4.0 as "4").
+        let fitness: f64 = row[col("champion_fitness")].parse().unwrap();
+        assert_eq!(
+            Some(fitness.to_bits()),
+            summary["champion_fitness"].as_f64().map(f64::to_bits)
+        );
         assert_eq!(row[col("evaluations")], summary["evaluations"].to_string());
         let champion: serde_json::Value =
             serde_json::from_slice(&std::fs::read(folder.join("champion.json")).unwrap()).unwrap();

@@ -102,12 +102,13 @@ pub struct TaskSettings {
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
     /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
-    /// turning when the trial starts. `[fitted]` 1.25: the paper's Table 1
-    /// level for task 2 and its burst totals (docs/model.md, sweep S11)
+    /// turning when the trial starts. `[fitted]` 0.75: the paper's Table 1
+    /// and 2 levels for task 2 and its burst totals (docs/model.md, sweep S18)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
-    /// Task 3: initial forward (+y) speed (m/s). `[fitted]` 0.3 (docs/model.md)
+    /// Task 3: initial forward (+y) speed (m/s). `[fitted]` 0.4: the paper's
+    /// Table 1 and 2 levels for task 3 (docs/model.md, sweep S17)
     pub task3_speed: f64,
     /// Task 3: distance of the target along +y (m). `[chosen]` 0.40
     pub task3_distance: f64,
@@ -123,9 +124,9 @@ impl Default for TaskSettings {
         TaskSettings {
             task1_spin: 1.0,
             task2_target_heading: FRAC_PI_2,
-            task2_spin: 1.25,
+            task2_spin: 0.75,
             task2_velocity: [0.0, 0.0],
-            task3_speed: 0.3,
+            task3_speed: 0.4,
             task3_distance: 0.40,
             task3_target_heading: 0.0,
             task3_random_distance: [0.25, 0.55],
