@@ -155,6 +155,17 @@ fn bench_prints_ns_per_step_for_every_backend_and_the_logistic_share() {
     assert_eq!(logistic["per_network_step"], 9, "{logistic}");
     let share = logistic["percent_of_batched_network_step"].as_f64().unwrap();
     assert!(share > 0.0 && share.is_finite(), "{logistic}");
+    // The paper's noisy configurations have rows of their own: native's
+    // scalar path and its best batched one under input noise.
+    let noisy: Vec<_> = report["psa_evaluation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["path"]["input_noise"] == true)
+        .collect();
+    assert_eq!(noisy.len(), 2, "{noisy:?}");
+    assert!(noisy.iter().all(|e| e["path"]["backend"] == "native"), "{noisy:?}");
+    assert!(noisy.iter().all(|e| e["ns_per_network_step_1_thread"].as_f64().unwrap() > 0.0));
 }
 
 /// A hand-made 7-3-4 spin damper: neuron 0 fires thrusters 2 and 3

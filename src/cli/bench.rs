@@ -19,6 +19,7 @@ use super::bench_networks::{random_networks, HIDDEN};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
 use crate::evaluator::{EvalPath, PsaEvaluator};
 use crate::evolution::evaluate_all;
+use crate::experiment::PAPER_NOISE_SD;
 use crate::network::Network;
 use crate::numeric::{sigmoid, Lanes, SimdLevel};
 use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
@@ -70,22 +71,30 @@ pub struct EvaluationPath {
     pub simd: Option<SimdLevel>,
     /// On `ode`, the lockstep path; otherwise one world per network.
     pub ode_lockstep: bool,
+    /// Under the paper's input noise (sd 0.05), as in its noisy configurations.
+    pub input_noise: bool,
 }
 
 impl EvaluationPath {
     /// The path's name in the bench's table.
     pub fn label(&self) -> String {
-        match (self.backend, self.simd) {
+        let path = match (self.backend, self.simd) {
             (BackendKind::Native, None) => "native scalar".into(),
             (BackendKind::Native, Some(level)) => format!("native batched {level}"),
             (BackendKind::Ode, _) if self.ode_lockstep => "ode lockstep".into(),
             (BackendKind::Ode, _) => "ode one world each".into(),
             (backend, _) => backend.name().into(),
+        };
+        if self.input_noise {
+            format!("{path}, input noise")
+        } else {
+            path
         }
     }
 
     /// ode one world per network and in lockstep, native scalar, native
-    /// batched on every level the CPU has, rapier.
+    /// batched on every level the CPU has, rapier; then native scalar and
+    /// batched on the CPU's best level under input noise.
     pub fn all() -> Vec<EvaluationPath> {
         let mut paths = Vec::new();
         for backend in BackendKind::available() {
@@ -93,6 +102,7 @@ impl EvaluationPath {
                 backend,
                 simd: None,
                 ode_lockstep: false,
+                input_noise: false,
             };
             paths.push(path);
             if backend == BackendKind::Ode {
@@ -113,15 +123,30 @@ impl EvaluationPath {
                 );
             }
         }
+        let native = |p: &&EvaluationPath| p.backend == BackendKind::Native;
+        let scalar = paths.iter().find(|p| native(p) && p.simd.is_none());
+        let best_batched = paths.iter().rfind(|p| native(p) && p.simd.is_some());
+        let noisy: Vec<_> = [scalar, best_batched]
+            .into_iter()
+            .flatten()
+            .map(|&path| EvaluationPath {
+                input_noise: true,
+                ..path
+            })
+            .collect();
+        paths.extend(noisy);
         paths
     }
 
     /// The evaluator of the benchmark's task (task 1, default settings) on this path.
     pub fn evaluator(&self) -> Result<PsaEvaluator> {
-        let settings = PsaSettings {
+        let mut settings = PsaSettings {
             backend: self.backend,
             ..PsaSettings::default()
         };
+        if self.input_noise {
+            settings.noise.input_sd = PAPER_NOISE_SD;
+        }
         let path = match (self.simd, self.ode_lockstep) {
             (Some(level), _) => EvalPath::Simd(level),
             (None, true) => EvalPath::OdeLockstep,
@@ -339,7 +364,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
     let lockstep = super::bench_ode::lockstep_by_world_size(&networks, args.rounds)?;
     let best_batched = evaluations
         .iter()
-        .filter(|e| e.path.simd.is_some())
+        .filter(|e| e.path.simd.is_some() && !e.path.input_noise)
         .map(|e| e.ns_per_network_step_1_thread)
         .next_back();
     let logistic_ns = logistic_ns_per_value(args.rounds);
@@ -406,7 +431,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
             args.networks
         );
         say!(
-            "{:<22} {:>14} {:>14} {:>9} {:>16}",
+            "{:<34} {:>14} {:>14} {:>9} {:>16}",
             "path",
             "evals/s 1 thr",
             "evals/s 2 thr",
@@ -415,7 +440,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         );
         for e in &evaluations {
             say!(
-                "{:<22} {:>14.0} {:>14.0} {:>8.2}x {:>16.1}",
+                "{:<34} {:>14.0} {:>14.0} {:>8.2}x {:>16.1}",
                 e.path.label(),
                 e.evaluations_per_second_1_thread,
                 e.evaluations_per_second_2_threads,
