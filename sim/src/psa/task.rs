@@ -110,7 +110,9 @@ pub struct TaskSettings {
     /// Task 3: initial forward (+y) speed (m/s). `[fitted]` 0.4: the paper's
     /// Table 1 and 2 levels for task 3 (docs/model.md, sweep S17)
     pub task3_speed: f64,
-    /// Task 3: distance of the target along +y (m). `[chosen]` 0.40
+    /// Task 3: distance of the target along +y (m). `[fitted]` 0.40, the
+    /// middle of the random starts' range: both ends fit Tables 1 and 2 worse
+    /// (docs/model.md, sweep S20)
     pub task3_distance: f64,
     /// Task 3: target heading (rad). `[fitted]` 0, the start heading: the
     /// PSA turns round to brake and back again (docs/model.md)
