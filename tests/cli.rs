@@ -165,7 +165,9 @@ fn bench_prints_ns_per_step_for_every_backend_and_the_logistic_share() {
         .collect();
     assert_eq!(noisy.len(), 2, "{noisy:?}");
     assert!(noisy.iter().all(|e| e["path"]["backend"] == "native"), "{noisy:?}");
-    assert!(noisy.iter().all(|e| e["ns_per_network_step_1_thread"].as_f64().unwrap() > 0.0));
+    assert!(noisy
+        .iter()
+        .all(|e| e["ns_per_network_step_1_thread"].as_f64().unwrap() > 0.0));
 }
 
 /// A hand-made 7-3-4 spin damper: neuron 0 fires thrusters 2 and 3
