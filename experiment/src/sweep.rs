@@ -464,7 +464,7 @@ mod tests {
             "problem.fitness.scoring=evolution,original",
             "problem.fitness.state=truth,sensed",
             "problem.sensors.heading_input=error,absolute",
-            "problem.sensors.heading_wrap=symmetric,positive",
+            "problem.sensors.heading_wrap=positive,symmetric",
             "problem.noise.on_bias=false,true",
             "problem.task3.fitness=original",
             "problem.task3.scoring=incremental",
@@ -515,10 +515,10 @@ mod tests {
             HeadingInput::Absolute
         );
         assert_eq!(
-            problem(at("problem.sensors.heading_wrap=positive"))
+            problem(at("problem.sensors.heading_wrap=symmetric"))
                 .sensors
                 .heading_wrap,
-            HeadingWrap::Positive
+            HeadingWrap::Symmetric
         );
         assert!(problem(at("problem.noise.on_bias=true")).noise.on_bias);
         let task3 = problem(at("problem.task3.fitness=original"));

@@ -59,7 +59,7 @@ pub fn original_fitness_settings() -> PsaSettings {
 }
 
 /// Every reading of the inputs and the fitness that is not the default,
-/// together: the heading input absolute and wrapped to [0, 2 pi), the
+/// together: the heading input absolute and wrapped to (-pi, pi], the
 /// fitness read from the sensed state, and task 3 evolved on the original
 /// fitness over 250 steps (task 1 scored on it, which the evaluation paths
 /// ignore); first with noise on every input, the bias included, outputs
@@ -68,7 +68,7 @@ pub fn reading_settings() -> [(&'static str, PsaSettings); 2] {
     let mut readings = noisy_settings();
     readings.noise.on_bias = true;
     readings.sensors.heading_input = HeadingInput::Absolute;
-    readings.sensors.heading_wrap = HeadingWrap::Positive;
+    readings.sensors.heading_wrap = HeadingWrap::Symmetric;
     readings.fitness.state = FitnessState::Sensed;
     readings.task3 = TaskOverrides {
         steps: Some(250),

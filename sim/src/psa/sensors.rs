@@ -27,10 +27,11 @@ pub enum HeadingInput {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum HeadingWrap {
-    /// (-pi, pi]. `[chosen]` default
-    #[default]
+    /// (-pi, pi]: the default before sweep S22.
     Symmetric,
-    /// [0, 2 pi).
+    /// [0, 2 pi): the input jumps by 2 pi where the heading crosses its
+    /// target. `[fitted]` default (docs/model.md, sweeps S21 and S22)
+    #[default]
     Positive,
 }
 
@@ -61,7 +62,8 @@ pub struct SensorSettings {
     pub bias: f64,
     /// What the heading input measures. `[chosen]` error
     pub heading_input: HeadingInput,
-    /// The range the heading input is wrapped to. `[chosen]` symmetric
+    /// The range the heading input is wrapped to. `[fitted]` positive,
+    /// [0, 2 pi) (docs/model.md, sweeps S21 and S22)
     pub heading_wrap: HeadingWrap,
 }
 
@@ -74,7 +76,7 @@ impl Default for SensorSettings {
             angular_velocity_scale: 1.0,
             bias: 1.0,
             heading_input: HeadingInput::Error,
-            heading_wrap: HeadingWrap::Symmetric,
+            heading_wrap: HeadingWrap::default(),
         }
     }
 }

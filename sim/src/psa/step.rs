@@ -145,6 +145,7 @@ mod tests {
     #[test]
     fn the_heading_input_is_the_error_or_the_heading_in_its_wrap_range() {
         let mut s = Settings::default();
+        s.sensors.heading_wrap = HeadingWrap::Symmetric;
         let target = [0.0, 0.0, 1.0];
         // The error: heading -3 against target 1 is -4, wrapped to 2 pi - 4.
         assert_eq!(clean_reading(&s, -3.0, target).inputs[4], TAU - 4.0);
