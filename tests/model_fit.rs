@@ -143,7 +143,7 @@ fn the_scored_on_original_file_repeats_the_records_of_the_first_original_scoring
 
 #[test]
 fn the_symmetric_heading_file_repeats_the_records_of_the_model_before_the_positive_wrap_byte_for_byte() {
-    // Recorded by build 82f0df7, whose defaults the file pins; evolution
+    // Recorded by build aeb463d (the code of 82f0df7), whose defaults the file pins; evolution
     // from random starts too.
     let config = "configs/symmetric-heading.toml";
     assert_repeats_the_golden_records(config, "symmetric-heading", &["baseline", "max-credit"]);
