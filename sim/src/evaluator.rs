@@ -266,28 +266,54 @@ impl Evaluator for PsaEvaluator {
         range: Range<usize>,
         streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
-        let rngs = || -> Vec<Stream> { range.clone().map(|j| streams.stream(j)).collect() };
+        if self.kernel.is_none() && self.batch.is_none() && !self.ode_lockstep {
+            return evaluate_each(self, worker, networks, range, streams);
+        }
+        let mut rngs: Vec<Stream> = range.clone().map(|j| streams.stream(j)).collect();
+        self.evaluate_with_streams(worker, networks, range, &mut rngs)
+    }
+}
+
+impl PsaEvaluator {
+    /// The fitness of networks `range` of `networks`, network
+    /// `range.start + i` with the stream `rngs[i]` (any streams, such as
+    /// one per network from a seed of its own), on this evaluator's path:
+    /// what [`Evaluator::evaluate`] gives each with its stream, bit for bit.
+    /// [`Evaluator::evaluate_batch`] is this with the streams of a
+    /// [`StreamFamily`]; a caller evaluating networks with streams of its
+    /// own (the Python binding's `evaluate`, which flies every network as
+    /// `psa-esp replay` does) cuts them into [`Evaluator::batch_size`]
+    /// pieces, each with its worker.
+    ///
+    /// # Panics
+    /// If `range` and `rngs` differ in length.
+    pub fn evaluate_with_streams<S: NetworkSet + ?Sized>(
+        &self,
+        worker: &mut PsaWorker,
+        networks: &S,
+        range: Range<usize>,
+        rngs: &mut [Stream],
+    ) -> Result<Vec<f64>> {
+        assert_eq!(range.len(), rngs.len(), "one stream per network");
         if let Some(flier) = &self.kernel {
             let (settings, task) = (&self.settings, self.task);
-            return Ok(cuda::evaluate_with(
-                settings,
-                task,
-                networks,
-                range.clone(),
-                &mut rngs(),
-                |batch| flier.fly(batch),
-            )?);
+            return Ok(cuda::evaluate_with(settings, task, networks, range, rngs, |batch| {
+                flier.fly(batch)
+            })?);
         }
         if let Some(batch) = &self.batch {
-            return Ok(batch.evaluate(networks, range.clone(), &mut rngs())?);
+            return Ok(batch.evaluate(networks, range, rngs)?);
         }
         if self.ode_lockstep {
             if worker.lockstep.is_none() {
                 worker.lockstep = Some(OdeLockstepRunner::new(&self.settings, self.task)?);
             }
             let lockstep = worker.lockstep.as_mut().expect("just made");
-            return Ok(lockstep.evaluate(networks, range.clone(), &mut rngs())?);
+            return Ok(lockstep.evaluate(networks, range, rngs)?);
         }
-        evaluate_each(self, worker, networks, range, streams)
+        range
+            .zip(rngs)
+            .map(|(j, rng)| self.evaluate(worker, &networks.network(j), rng))
+            .collect()
     }
 }
