@@ -1,0 +1,242 @@
+//! One trial flown step by step from Python: what the Gymnasium
+//! environment (`psa_esp.env.PsaEnv`) steps. Each step is the scalar
+//! trial's step (`psa_sim::psa::trial`), operation for operation, so a
+//! network flown through it scores what `evaluate` gives.
+
+use numpy::{PyArray1, PyArrayMethods};
+use psa_sim::numeric::{clamp_unit, NoiseSource};
+use psa_sim::physics::{create_backend, PhysicsBackend, PlanarState};
+use psa_sim::psa::step::{score, sense, Reading};
+use psa_sim::psa::{PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
+use psa_sim::rng::stream;
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+use crate::config::{run_config, type_name};
+use crate::errors;
+use crate::evaluate::{task_of, REPLAY_STREAM};
+
+/// A trial under way.
+struct Flight {
+    target: [f64; 3],
+    noise: NoiseSource<u64>,
+    state: PlanarState<f64>,
+    reading: Reading<f64>,
+    points: f64,
+    steps: usize,
+}
+
+/// One trial of a task, flown a control step at a time.
+///
+/// `Trial(task, config=None, *, preset="baseline", backend=None,
+/// random_init=None)`: the problem `config` resolves to (see `evaluate`),
+/// for `task`. `reset(seed)` starts a trial as `psa-esp replay --seed
+/// seed` starts its first (the paper's start, or a random one under
+/// `random_init`), `step(thrust)` applies four thruster commands for one
+/// step. Lives on the thread that made it (its physics world may be an
+/// ODE world).
+#[pyclass(module = "psa_esp._native", unsendable)]
+pub struct Trial {
+    settings: PsaSettings,
+    task: Task,
+    backend: Box<dyn PhysicsBackend>,
+    maximum: f64,
+    flight: Option<Flight>,
+}
+
+impl Trial {
+    /// What the controller reads of the state now.
+    fn read(
+        settings: &PsaSettings,
+        state: &PlanarState<f64>,
+        target: [f64; 3],
+        noise: &mut NoiseSource<u64>,
+    ) -> Reading<f64> {
+        let read = if settings.noise.is_active() {
+            sense::<f64, true>
+        } else {
+            sense::<f64, false>
+        };
+        read(
+            settings.step(),
+            state.position,
+            state.velocity,
+            state.heading(),
+            state.omega,
+            target,
+            noise,
+        )
+    }
+}
+
+/// The error of a step or a reading before `reset`.
+fn not_started() -> PyErr {
+    PyRuntimeError::new_err("the trial has not started: call reset(seed) first")
+}
+
+#[pymethods]
+impl Trial {
+    #[new]
+    #[pyo3(signature = (task, config=None, *, preset="baseline", backend=None, random_init=None))]
+    fn new(
+        task: u8,
+        config: Option<&Bound<'_, PyAny>>,
+        preset: &str,
+        backend: Option<&str>,
+        random_init: Option<bool>,
+    ) -> PyResult<Trial> {
+        let task = task_of(task)?;
+        let mut problem = run_config(config, preset, backend)?.problem;
+        if let Some(random_init) = random_init {
+            problem.random_init = random_init;
+        }
+        let settings = problem.for_task(task).map_err(|e| errors::config(e.to_string()))?;
+        let model = settings.body.model().map_err(|e| errors::config(e.to_string()))?;
+        let backend = create_backend(settings.backend, &model, &settings.physics).map_err(errors::simulation)?;
+        Ok(Trial {
+            maximum: settings.fitness.maximum(settings.steps),
+            settings,
+            task,
+            backend,
+            flight: None,
+        })
+    }
+
+    /// Starts a trial with the random stream of `seed` (the start, under
+    /// random initialisation, and the noise are drawn from it); returns
+    /// the first observation, the network's 7 inputs.
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let s = &self.settings;
+        let mut rng = stream(seed, &[REPLAY_STREAM]);
+        let (start, target) = s.tasks.start_and_target(self.task, s.random_init, &mut rng);
+        self.backend.reset(&start).map_err(errors::simulation)?;
+        let mut noise = NoiseSource::new(s.noise.draw_seed(&mut rng));
+        let target = [target.x, target.y, target.heading];
+        let state = self.backend.planar_state();
+        let reading = Trial::read(s, &state, target, &mut noise);
+        let inputs = reading.inputs;
+        self.flight = Some(Flight {
+            target,
+            noise,
+            state,
+            reading,
+            points: 0.0,
+            steps: 0,
+        });
+        Ok(PyArray1::from_slice(py, &inputs))
+    }
+
+    /// Applies `thrust` (4 commands, clamped to [0, 1] after the output
+    /// noise, if any) for one step. Returns the next observation and the
+    /// step's increment of the trial's fitness, in % of the maximum.
+    fn step<'py>(&mut self, py: Python<'py>, thrust: &Bound<'py, PyAny>) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
+        let commands: Vec<f64> = match thrust.cast::<PyArray1<f64>>() {
+            Ok(array) => array.to_vec().map_err(|e| PyValueError::new_err(e.to_string()))?,
+            Err(_) => thrust.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "thrust must be {THRUSTER_COUNT} floats, got {}",
+                    type_name(thrust)
+                ))
+            })?,
+        };
+        if commands.len() != THRUSTER_COUNT {
+            return Err(PyValueError::new_err(format!(
+                "thrust must be {THRUSTER_COUNT} floats, got {}",
+                commands.len()
+            )));
+        }
+        if let Some(bad) = commands.iter().find(|u| !u.is_finite()) {
+            return Err(PyValueError::new_err(format!("thrust must be finite, got {bad}")));
+        }
+        let steps = self.settings.steps;
+        let maximum = self.maximum;
+        let flight = self.flight.as_mut().ok_or_else(not_started)?;
+        if flight.steps >= steps {
+            return Err(PyRuntimeError::new_err(format!(
+                "the trial is over after {steps} steps: call reset(seed) to start another"
+            )));
+        }
+        let mut outputs = [0.0; THRUSTER_COUNT];
+        outputs.copy_from_slice(&commands);
+        let s = &self.settings;
+        if s.noise.is_active() {
+            s.noise.perturb_outputs(&mut outputs, &mut flight.noise);
+        }
+        for u in &mut outputs {
+            *u = clamp_unit(*u);
+        }
+        self.backend.step(&outputs).map_err(errors::simulation)?;
+        let previous_omega = flight.state.omega;
+        flight.state = self.backend.planar_state();
+        let next = Trial::read(s, &flight.state, flight.target, &mut flight.noise);
+        let points = score(
+            s.step(),
+            &next,
+            &flight.reading,
+            flight.state.position,
+            flight.state.omega,
+            previous_omega,
+            flight.target,
+        );
+        flight.reading = next;
+        flight.points += points;
+        flight.steps += 1;
+        Ok((
+            PyArray1::from_slice(py, &flight.reading.inputs),
+            100.0 * points / maximum,
+        ))
+    }
+
+    /// The trial's fitness so far, in % of the task's theoretical
+    /// maximum: after the last step, the bits `evaluate` gives (one trial).
+    #[getter]
+    fn fitness(&self) -> f64 {
+        self.flight.as_ref().map_or(0.0, |f| 100.0 * f.points / self.maximum)
+    }
+
+    /// Steps flown in this trial.
+    #[getter]
+    fn steps_done(&self) -> usize {
+        self.flight.as_ref().map_or(0, |f| f.steps)
+    }
+
+    /// Steps a trial lasts.
+    #[getter]
+    fn steps(&self) -> usize {
+        self.settings.steps
+    }
+
+    /// Whether the trial has flown all its steps.
+    #[getter]
+    fn done(&self) -> bool {
+        self.flight.as_ref().is_some_and(|f| f.steps >= self.settings.steps)
+    }
+
+    /// The body's state: x, y (m, world frame), heading (rad), vx, vy
+    /// (m/s), omega (rad/s).
+    #[getter]
+    fn state(&self) -> PyResult<[f64; 6]> {
+        let f = self.flight.as_ref().ok_or_else(not_started)?;
+        let s = &f.state;
+        Ok([
+            s.position[0],
+            s.position[1],
+            s.heading(),
+            s.velocity[0],
+            s.velocity[1],
+            s.omega,
+        ])
+    }
+
+    /// The target: x, y (m), heading (rad).
+    #[getter]
+    fn target(&self) -> PyResult<[f64; 3]> {
+        Ok(self.flight.as_ref().ok_or_else(not_started)?.target)
+    }
+
+    /// The number of inputs (observations).
+    #[classattr]
+    fn inputs() -> usize {
+        INPUT_COUNT
+    }
+}
