@@ -1,0 +1,83 @@
+"""The Gymnasium environments: check_env, and a trial flown step by step
+scoring what evaluate gives."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import psa_esp
+from psa_esp.env import PsaEnv
+
+
+@pytest.mark.parametrize("task", [1, 2, 3])
+def test_check_env_passes(task):
+    env = gymnasium.make(f"psa_esp/Task{task}-v0")
+    check_env(env.unwrapped, skip_render_check=True)
+    check_env(PsaEnv(task, {"problem": {"noise": {"input_sd": 0.05, "output_sd": 0.05}}}), skip_render_check=True)
+
+
+def fly(env, network, seed):
+    """One episode of `network` from reset(seed); the rewards and the last info."""
+    observation, info = env.reset(seed=seed)
+    rewards = []
+    while True:
+        observation, reward, terminated, truncated, info = env.step(network.activate(observation))
+        rewards.append(reward)
+        assert not terminated
+        if truncated:
+            return rewards, info
+
+
+@pytest.mark.parametrize(
+    ("task", "problem"),
+    [
+        (1, {}),
+        (2, {"noise": {"input_sd": 0.05, "output_sd": 0.05}}),
+        (3, {"random_init": True, "noise": {"input_sd": 0.05}}),
+        (1, {"random_init": True, "fitness": {"kind": "original"}}),
+    ],
+)
+def test_a_trial_flown_step_by_step_scores_what_evaluate_gives(champions, task, problem):
+    config = {"problem": problem}
+    network = psa_esp.Network(champions[task], task, config)
+    env = gymnasium.make(f"psa_esp/Task{task}-v0", config=config)
+    for seed in [1, 42]:
+        rewards, info = fly(env, network, seed)
+        expected = psa_esp.evaluate(champions[task][None], task, config, seed=seed, trials=1)[0]
+        assert info["fitness"] == expected
+        assert len(rewards) == env.unwrapped.steps == 500
+        assert sum(rewards) == pytest.approx(expected, abs=1e-9)
+    assert expected > 0
+
+
+def test_reset_by_seed_is_deterministic_and_random_starts_differ():
+    env = PsaEnv(1, random_init=True)
+    first, info = env.reset(seed=3)
+    again, _ = env.reset(seed=3)
+    assert np.array_equal(first, again)
+    other, _ = env.reset(seed=4)
+    assert not np.array_equal(first, other), "a random start's heading depends on the seed"
+    paper = PsaEnv(1)
+    assert np.array_equal(paper.reset(seed=3)[0], paper.reset(seed=4)[0]), "the paper's start is fixed"
+
+
+def test_stepping_wrongly_raises_clear_exceptions():
+    env = PsaEnv(2)
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros(4))
+    env.reset(seed=1)
+    with pytest.raises(ValueError, match="finite"):
+        env.step(np.array([0.0, np.nan, 0.0, 0.0]))
+    with pytest.raises(ValueError):
+        env.step(np.zeros(3))
+    for _ in range(env.steps):
+        env.step(np.zeros(4))
+    with pytest.raises(RuntimeError, match="over"):
+        env.step(np.zeros(4))
+    with pytest.raises(psa_esp.ConfigError, match="no_such"):
+        PsaEnv(1, {"problem": {"no_such": 1}})
+    with pytest.raises(psa_esp.ConfigError, match="random-initialisation"):
+        PsaEnv(2, random_init=True)
