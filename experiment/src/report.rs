@@ -30,7 +30,7 @@ use super::GridConfig;
 use crate::psa::Task;
 use crate::results::{load_run, GenerationRow, RunData};
 
-pub use distance::{Distance, Term};
+pub use distance::{Distance, Part, Term};
 pub use findings::{Finding, Rule, Verdict, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
 pub use paper::{
     paper_bursts, paper_bursts_per_run, paper_cell, PaperCell, PAPER_BURSTS, PAPER_BURST_RUNS, PAPER_RUNS_ALL,

@@ -14,7 +14,7 @@ mod stagnation;
 #[cfg(test)]
 mod tests;
 
-pub use settings::{BurstMode, Credit, EspSettings, Sampling, StagnationRule, TopologyMode};
+pub use settings::{BurstMode, Credit, EraseAt, EspSettings, Relesion, Sampling, StagnationRule, TopologyMode};
 
 /// An ESP run: settings, seed and when to stop early.
 use serde::{Deserialize, Serialize};
