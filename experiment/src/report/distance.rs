@@ -177,9 +177,15 @@ impl Distance {
             paper_ratio,
             paper_ratio * (1.0 / base + 1.0 / max).sqrt(),
         );
-        let part = |part: Part| terms.iter().filter(|t| t.part == part).map(|t| t.z * t.z).sum();
+        // Folded from +0.0: a sum of no terms is 0, not the -0.0 of `Sum`.
+        let part = |part: Part| {
+            terms
+                .iter()
+                .filter(|t| t.part == part)
+                .fold(0.0, |sum, t| sum + t.z * t.z)
+        };
         Distance {
-            total: terms.iter().map(|t| t.z * t.z).sum(),
+            total: terms.iter().fold(0.0, |sum, t| sum + t.z * t.z),
             means: part(Part::Mean),
             spreads: part(Part::Spread),
             burst_ratio: part(Part::BurstRatio),
