@@ -229,10 +229,15 @@ impl NetworkFile {
         if let Some(problem) = value.get_mut("problem").filter(|p| p.is_object()) {
             super::defaults::fill(problem, "problem.", &placement).map_err(|e| fail(format!("problem: {e}")))?;
         }
+        // The input scaling is the problem's sensors, and lacks what they lack.
+        if let Some(scaling) = value.get_mut("input_scaling").filter(|p| p.is_object()) {
+            super::defaults::fill(scaling, "problem.sensors.", &placement)
+                .map_err(|e| fail(format!("input_scaling: {e}")))?;
+        }
         if let Some(problem) = value.get("problem") {
             if let Err(e) = serde_json::from_value::<PsaSettings>(problem.clone()) {
                 let key = bad_key(problem, &|v| serde_json::from_value::<PsaSettings>(v.clone()).is_ok())
-                    .map_or(String::new(), |key| format!(" {key}"));
+                    .unwrap_or_default();
                 return Err(fail(format!("problem{key}: {e}")));
             }
         }
