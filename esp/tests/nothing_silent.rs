@@ -19,10 +19,7 @@ fn a_clone_of_a_run_has_a_ticket_identity_of_its_own() {
     let mut clone = original.clone();
     let fitness = vec![0.0; clone.ask().unwrap().expect("the clone's ask").len()];
     // The original's ticket is foreign to the clone, and the clone's to the original.
-    assert!(matches!(
-        clone.tell(ticket, &fitness),
-        Err(RunError::ForeignTicket)
-    ));
+    assert!(matches!(clone.tell(ticket, &fitness), Err(RunError::ForeignTicket)));
     let clone_ticket = clone.ask().unwrap().unwrap().ticket();
     assert!(matches!(
         original.tell(clone_ticket, &fitness),

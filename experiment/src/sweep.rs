@@ -429,13 +429,9 @@ fn set_grid_key(grid: &mut GridSpec, key: &str, value: &str) -> Result<()> {
         .with_context(|| format!("{key} = {value}"))?;
     let value = parsed["v"].clone();
     if key == "problem.backend" {
-        grid.backend = value
-            .try_into()
-            .with_context(|| format!("{key}: not a backend"))?;
+        grid.backend = value.try_into().with_context(|| format!("{key}: not a backend"))?;
     } else {
-        let generations: usize = value
-            .try_into()
-            .with_context(|| format!("{key}: not a count"))?;
+        let generations: usize = value.try_into().with_context(|| format!("{key}: not a count"))?;
         grid.generations = generations;
     }
     Ok(())

@@ -231,15 +231,15 @@ pub fn remove_stale_temporaries(dir: &Path) -> usize {
         let Some(at) = name.find(&marker).filter(|_| name.starts_with('.')) else {
             continue;
         };
-        let pid: String = name[at + marker.len()..].chars().take_while(char::is_ascii_digit).collect();
+        let pid: String = name[at + marker.len()..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect();
         let Ok(pid) = pid.parse::<u32>() else { continue };
         let gone = pid != std::process::id()
             && Path::new("/proc/self").exists()
             && !Path::new(&format!("/proc/{pid}")).exists();
-        if gone
-            && entry.file_type().is_ok_and(|t| t.is_file())
-            && fs::remove_file(entry.path()).is_ok()
-        {
+        if gone && entry.file_type().is_ok_and(|t| t.is_file()) && fs::remove_file(entry.path()).is_ok() {
             removed += 1;
         }
     }

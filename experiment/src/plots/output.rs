@@ -69,7 +69,9 @@ pub(crate) fn write_svg_and_png(
     crate::io::write_atomic(svg_path, svg.as_bytes())?;
     crate::io::check_output_file(png_path)?;
     let dir = png_path.parent().unwrap_or(Path::new("."));
-    let name = png_path.file_name().map_or("figure.png".into(), |s| s.to_string_lossy());
+    let name = png_path
+        .file_name()
+        .map_or("figure.png".into(), |s| s.to_string_lossy());
     // A temporary name of the usual form (so that a killed report's is
     // cleared by the next), ending in .png for the drawing backend.
     let tmp = dir.join(format!("{}.png", crate::io::temporary_name(&name)));

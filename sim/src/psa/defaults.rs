@@ -297,7 +297,10 @@ mod tests {
             value_at(wrap, &at(&format!("{head}-dirty"))).unwrap(),
             Some("positive".into())
         );
-        assert_eq!(value_at(wrap, &Placement::Rows(rows())).unwrap(), Some("positive".into()));
+        assert_eq!(
+            value_at(wrap, &Placement::Rows(rows())).unwrap(),
+            Some("positive".into())
+        );
         assert_eq!(value_at(wrap, &Placement::Rows(10)).unwrap(), Some("symmetric".into()));
         let err = value_at(wrap, &at("0123456789abcdef")).unwrap_err();
         assert!(err.contains(wrap) && err.contains("0123456789abcdef"), "{err}");

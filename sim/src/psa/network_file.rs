@@ -236,8 +236,8 @@ impl NetworkFile {
         }
         if let Some(problem) = value.get("problem") {
             if let Err(e) = serde_json::from_value::<PsaSettings>(problem.clone()) {
-                let key = bad_key(problem, &|v| serde_json::from_value::<PsaSettings>(v.clone()).is_ok())
-                    .unwrap_or_default();
+                let key =
+                    bad_key(problem, &|v| serde_json::from_value::<PsaSettings>(v.clone()).is_ok()).unwrap_or_default();
                 return Err(fail(format!("problem{key}: {e}")));
             }
         }
