@@ -267,6 +267,31 @@ impl GridSpec {
         Ok(c)
     }
 
+    /// The configuration a run of `config` had in this grid when the build
+    /// at `placement` wrote it: [`GridSpec::run_config`] with every setting
+    /// of the table of defaults (`psa::defaults`) at that build's value,
+    /// under the grid's overrides. An error when the build cannot be placed.
+    pub fn run_config_at(&self, config: GridConfig, placement: &crate::psa::defaults::Placement) -> Result<RunConfig> {
+        let mut table = toml::Table::try_from(RunConfig::default())?;
+        for row in crate::psa::defaults::CHANGES {
+            let value = crate::psa::defaults::value_at(row.key, placement).map_err(anyhow::Error::msg)?;
+            if let Some(value) = value {
+                let value: toml::Value = serde_json::from_value(value)?;
+                set_leaf(&mut table, row.key, value);
+            }
+        }
+        if let Some(text) = &self.overrides {
+            let overrides: toml::Table = toml::from_str(text).context("the grid's configuration overrides")?;
+            super::config::merge(&mut table, overrides);
+        }
+        let base: RunConfig = table.try_into()?;
+        let mut c = config.apply(base);
+        c.esp.generations = self.generations;
+        c.hill_climb.cycles = self.generations;
+        c.problem.backend = self.backend;
+        Ok(c)
+    }
+
     /// The settings `grid.json` states itself for a run of `config`: its
     /// overrides, those the configuration's own change sets, generations
     /// and backend (what [`Judge::Read`] checks a run against).
@@ -275,7 +300,11 @@ impl GridSpec {
         let base = match &self.overrides {
             Some(text) => {
                 let mut set = Vec::new();
-                leaves(&toml::from_str(text).context("the grid's configuration overrides")?, "", &mut set);
+                leaves(
+                    &toml::from_str(text).context("the grid's configuration overrides")?,
+                    "",
+                    &mut set,
+                );
                 keys.extend(set.into_iter().map(|(k, _)| k));
                 RunConfig::baseline_with(text).context("the grid's configuration overrides")?
             }
@@ -383,6 +412,25 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
         }
         Judge::Read => {
             let found = run_folder_config(&folder)?;
+            // The run as its own build made it: this grid under that build's
+            // defaults (`psa::defaults`); every setting must agree.
+            if let Ok(at_build) = spec.run_config_at(key.config, &folder_placement(&folder)) {
+                let differ = differences(&found, &at_build)?;
+                if !differ.is_empty() {
+                    let shown: Vec<String> = differ
+                        .iter()
+                        .map(|(setting, there, here)| format!("{setting} = {there} there, {here} in this grid"))
+                        .collect();
+                    bail!(
+                        "{}: holds a different configuration than {} in this grid under the defaults of its build ({}): {} (another grid's run?); move it away",
+                        folder.display(),
+                        key.config,
+                        folder_build(&folder),
+                        shown.join("; ")
+                    );
+                }
+            }
+            // A build that cannot be placed: the settings grid.json states.
             for setting in spec.stated_keys(key.config)? {
                 let (there, here) = (leaf(&found, &setting)?, leaf(&expected, &setting)?);
                 if there != here {
@@ -457,6 +505,25 @@ fn folder_build(folder: &Path) -> String {
         ),
         None => "the run is unfinished: no run.json names its build".into(),
     }
+}
+
+/// Sets the dotted `key` of `table` to `value`, making the tables on the way.
+fn set_leaf(table: &mut toml::Table, key: &str, value: toml::Value) {
+    let mut parts: Vec<&str> = key.split('.').collect();
+    let Some(last) = parts.pop() else {
+        return;
+    };
+    let mut at = table;
+    for part in parts {
+        let entry = at
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        let Some(inner) = entry.as_table_mut() else {
+            return;
+        };
+        at = inner;
+    }
+    at.insert(last.to_string(), value);
 }
 
 /// Every leaf setting of a TOML table, as dotted keys with their values.
