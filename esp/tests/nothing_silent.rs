@@ -2,8 +2,10 @@
 //! run of its own, a search read from JSON is checked as one built in
 //! code, and the seed is written where JSON tools keep every digit.
 
+use esp_neuroevolution::network::NetworkSet;
 use esp_neuroevolution::{AskTell, Esp, EspSettings, HillClimb, HillClimbSettings, RunError};
 
+#[allow(dead_code)] // this file uses a share of the helpers
 mod common;
 
 use common::small;
