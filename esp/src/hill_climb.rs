@@ -125,12 +125,32 @@ pub struct MutationRates {
     pub p_flip: f64,
 }
 
-/// A hill-climbing run: settings, seed and when to stop early.
+/// A hill-climbing run: settings, seed and when to stop early. Read from
+/// JSON it is checked as [`HillClimb::new`] checks it; the seed is written
+/// as a string (a number is read too).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "UncheckedHillClimb")]
 pub struct HillClimb {
     settings: HillClimbSettings,
+    #[serde(with = "crate::rng::u64_string")]
     seed: u64,
     stop: StopAt,
+}
+
+/// A [`HillClimb`] as read, before its settings are checked.
+#[derive(Deserialize)]
+struct UncheckedHillClimb {
+    settings: HillClimbSettings,
+    #[serde(with = "crate::rng::u64_string")]
+    seed: u64,
+    stop: StopAt,
+}
+
+impl TryFrom<UncheckedHillClimb> for HillClimb {
+    type Error = SettingsError;
+    fn try_from(raw: UncheckedHillClimb) -> Result<HillClimb, SettingsError> {
+        Ok(HillClimb::new(raw.settings, raw.seed)?.stop_at(raw.stop))
+    }
 }
 
 impl HillClimb {

@@ -158,11 +158,8 @@ fn grid_section(md: &mut String, report: &Report) {
     for (k, v) in rows {
         let _ = writeln!(md, "| {k} | {v} |");
     }
-    if let Some(config) = g.configs.first() {
-        if let (Ok(run), Ok(scoring)) = (g.run_config(*config), g.scoring_config(*config)) {
-            let readings = run.problem.describe_readings(&scoring.problem);
-            let _ = writeln!(md, "| readings | {} |", readings.join("; "));
-        }
+    if !report.readings.is_empty() {
+        let _ = writeln!(md, "| readings | {} |", report.readings.join("; "));
     }
     if let Some(rescoring) = &g.rescoring {
         let settings: Vec<String> = rescoring
