@@ -21,7 +21,7 @@
 //! default ever changed is refused, naming the key.
 //!
 //! Adding a row, when a default changes or a key is added, is one line at
-//! the end of [`CHANGES`]: `first("esp.erase_at", r#""burst""#)` for a new
+//! the end of [`CHANGES`]: `first("esp.erase_at", r#""topology_change""#)` for a new
 //! key whose absence means the earlier behaviour,
 //! `changed("esp.stagnation", "", "60")` for a changed default (the
 //! commit is left empty: builds from now on are placed by their row count).
@@ -100,6 +100,9 @@ pub const CHANGES: &[Change] = &[
     changed("esp.stagnation", "a70d696", "50"),
     first("esp.stagnation_rule", r#""all_time_best""#),
     changed("esp.stagnation_rule", "95ee59b", r#""phase_best""#),
+    first("esp.erase_at", r#""topology_change""#),
+    changed("esp.erase_at", "8cf59c9", r#""burst""#),
+    first("esp.relesion", r#""pending""#),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.
