@@ -424,7 +424,10 @@ fn distance_terms_follow_their_definitions() {
         .map(|&p| d.terms.iter().filter(|t| t.part == p).map(|t| t.z * t.z).sum::<f64>())
         .sum();
     assert!(close(parts, d.total) && close(d.means + d.spreads + d.burst_ratio, d.total));
-    assert!(d.burst_ratio == 0.0 && d.burst_ratio.is_sign_positive(), "a missing part prints as 0, not -0");
+    assert!(
+        d.burst_ratio == 0.0 && d.burst_ratio.is_sign_positive(),
+        "a missing part prints as 0, not -0"
+    );
 }
 
 #[test]
