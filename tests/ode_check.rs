@@ -171,7 +171,10 @@ fn a_champion_that_parted_the_backends_on_a_random_start_flies_alike_on_both() {
     std::fs::write(&normalised, "[problem.physics]\nstart_quaternion = \"normalised\"\n").unwrap();
     let today = ["--config", normalised.to_str().unwrap()];
     let ode = random_start_fitness(&network, "ode", &today);
-    assert_eq!(random_start_fitness(&network, "native", &today).to_bits(), ode.to_bits());
+    assert_eq!(
+        random_start_fitness(&network, "native", &today).to_bits(),
+        ode.to_bits()
+    );
     // On the model its file records (its build's raw start, from the table
     // of defaults in sim/src/psa/defaults.rs) it parts as it did; ODE
     // normalises either way.
