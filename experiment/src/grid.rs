@@ -430,7 +430,20 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
                     );
                 }
             }
-            // A build that cannot be placed: the settings grid.json states.
+            // A build that cannot be placed: every setting whose default never
+            // changed (no row in `psa::defaults`) holds at any build.
+            let changed_ever = |setting: &str| crate::psa::defaults::CHANGES.iter().any(|c| c.key == setting);
+            if let Some((setting, there, here)) = differences(&found, &expected)?
+                .into_iter()
+                .find(|(setting, _, _)| !changed_ever(setting))
+            {
+                bail!(
+                    "{}: holds a different configuration than {} in this grid: {setting} = {there} there, {here} at every build (another grid's run?); move it away",
+                    folder.display(),
+                    key.config,
+                );
+            }
+            // And the settings grid.json states.
             for setting in spec.stated_keys(key.config)? {
                 let (there, here) = (leaf(&found, &setting)?, leaf(&expected, &setting)?);
                 if there != here {
