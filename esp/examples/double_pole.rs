@@ -254,34 +254,6 @@ fn parse(args: &[String]) -> Result<Options, Box<dyn Error>> {
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn args(text: &str) -> Vec<String> {
-        text.split_whitespace().map(String::from).collect()
-    }
-
-    #[test]
-    fn every_documented_option_acts_and_any_other_is_refused() {
-        let o = parse(&args("--preset tuned --stagnation 50 --min-improvement 0.5 --quiet")).unwrap();
-        assert_eq!(o.settings.stagnation, 50);
-        assert_eq!(o.settings.stagnation_min_improvement, 0.5);
-        assert_eq!(o.settings.trials_per_neuron, 2);
-        assert!(o.quiet);
-        for (bad, needle) in [
-            ("--stagnaton 50", "--stagnaton"),
-            ("--stagnation", "needs a value"),
-            ("--seeds 3 --seeds 4", "twice"),
-            ("50", "\"50\""),
-            ("--min-improvement x", "--min-improvement"),
-        ] {
-            let err = parse(&args(bad)).err().expect(bad).to_string();
-            assert!(err.contains(needle), "{bad}: {err}");
-        }
-    }
-}
-
 fn main() -> Result<(), Box<dyn Error>> {
     let options = options()?;
     let angle = options.angle_degrees.to_radians();
@@ -314,4 +286,32 @@ fn main() -> Result<(), Box<dyn Error>> {
         options.budget,
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(text: &str) -> Vec<String> {
+        text.split_whitespace().map(String::from).collect()
+    }
+
+    #[test]
+    fn every_documented_option_acts_and_any_other_is_refused() {
+        let o = parse(&args("--preset tuned --stagnation 50 --min-improvement 0.5 --quiet")).unwrap();
+        assert_eq!(o.settings.stagnation, 50);
+        assert_eq!(o.settings.stagnation_min_improvement, 0.5);
+        assert_eq!(o.settings.trials_per_neuron, 2);
+        assert!(o.quiet);
+        for (bad, needle) in [
+            ("--stagnaton 50", "--stagnaton"),
+            ("--stagnation", "needs a value"),
+            ("--seeds 3 --seeds 4", "twice"),
+            ("50", "\"50\""),
+            ("--min-improvement x", "--min-improvement"),
+        ] {
+            let err = parse(&args(bad)).err().expect(bad).to_string();
+            assert!(err.contains(needle), "{bad}: {err}");
+        }
+    }
 }

@@ -206,15 +206,14 @@ fn resume(folder: &Path, fresh: AnyRun) -> Result<AnyRun> {
     let file = folder.join(CHECKPOINT);
     match std::fs::symlink_metadata(&file) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(fresh),
-        Ok(meta) if !meta.file_type().is_file() => {
-            // Refused by read_input_text below, naming what it is; a link is
-            // refused even when it points at a regular file.
-            if meta.file_type().is_symlink() {
-                anyhow::bail!(
-                    "{}: it is a symbolic link, not a regular file; remove it to start the run afresh",
-                    file.display()
-                );
-            }
+        // Anything else but a regular file is refused by read_input_text
+        // below, naming what it is; a link is refused even when it points at
+        // a regular file.
+        Ok(meta) if meta.file_type().is_symlink() => {
+            anyhow::bail!(
+                "{}: it is a symbolic link, not a regular file; remove it to start the run afresh",
+                file.display()
+            );
         }
         _ => {}
     }

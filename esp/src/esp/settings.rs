@@ -108,7 +108,7 @@ pub enum Relesion {
     Pending,
     /// At every discard-all burst mutation: §3.2's "discard all
     /// sub-populations at each round of burst mutation", each followed by
-    /// "a new lesion test ... on the [best] solution", whether or not a
+    /// "a new lesion test ... on the" best network, whether or not a
     /// change is pending.
     EveryBurst,
 }
