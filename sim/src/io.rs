@@ -290,34 +290,10 @@ pub fn read_versioned_json<T: serde::de::DeserializeOwned>(
     serde_json::from_value(value).with_context(|| format!("{}", path.display()))
 }
 
-/// A `u64` written to JSON as a string (`"18446744073709551615"`), read
-/// back from a string or a number. JSON tools that read numbers as doubles
-/// (jq, JavaScript, Python's `float`) lose digits above 2^53; a string keeps
-/// every seed exact. Use with `#[serde(with = "crate::io::u64_string")]`.
-pub mod u64_string {
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    /// Writes `value` as a decimal string.
-    pub fn serialize<S: Serializer>(value: &u64, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(value)
-    }
-
-    /// Reads a `u64` from a decimal string or a JSON number.
-    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<u64, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum Either {
-            Number(u64),
-            Text(String),
-        }
-        match Either::deserialize(deserializer)? {
-            Either::Number(n) => Ok(n),
-            Either::Text(text) => text
-                .parse()
-                .map_err(|_| serde::de::Error::custom(format!("{text:?} is not a whole number in [0, 2^64)"))),
-        }
-    }
-}
+/// Seeds as decimal strings in JSON (tools that read numbers as doubles
+/// lose digits above 2^53): the search crate's, so that both write them
+/// alike. Use with `#[serde(with = "crate::io::u64_string")]`.
+pub use esp_neuroevolution::rng::u64_string;
 
 #[cfg(test)]
 mod tests {

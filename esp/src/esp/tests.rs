@@ -436,6 +436,11 @@ fn records_of(settings: EspSettings, generations: usize) -> Vec<(GenerationRecor
         .collect()
 }
 
+/// The records of [`records_of`] as text, to compare two runs whole.
+fn debug_records(records: Vec<(GenerationRecord, Option<f64>)>) -> Vec<String> {
+    records.iter().map(|(r, _)| format!("{r:?}")).collect()
+}
+
 #[test]
 fn erase_at_burst_forgets_the_best_at_every_burst_and_lesion_tests_still_follow() {
     let erase = |at| EspSettings {
@@ -471,12 +476,9 @@ fn erase_at_burst_forgets_the_best_at_every_burst_and_lesion_tests_still_follow(
         erase_at: at,
         ..EspSettings::hoverstad()
     };
-    let records = |rs: Vec<(GenerationRecord, Option<f64>)>| -> Vec<String> {
-        rs.iter().map(|(r, _)| format!("{r:?}")).collect()
-    };
     assert_eq!(
-        records(records_of(off(EraseAt::Burst), 40)),
-        records(records_of(off(EraseAt::TopologyChange), 40))
+        debug_records(records_of(off(EraseAt::Burst), 40)),
+        debug_records(records_of(off(EraseAt::TopologyChange), 40))
     );
 }
 
@@ -574,12 +576,9 @@ fn relesion_every_burst_tests_the_best_at_each_discard_all_burst() {
         relesion: r,
         ..EspSettings::hoverstad()
     };
-    let records = |rs: Vec<(GenerationRecord, Option<f64>)>| -> Vec<String> {
-        rs.iter().map(|(r, _)| format!("{r:?}")).collect()
-    };
     assert_eq!(
-        records(records_of(gomez(Relesion::EveryBurst), 40)),
-        records(records_of(gomez(Relesion::Pending), 40))
+        debug_records(records_of(gomez(Relesion::EveryBurst), 40)),
+        debug_records(records_of(gomez(Relesion::Pending), 40))
     );
 }
 
