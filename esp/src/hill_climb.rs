@@ -42,7 +42,9 @@ pub struct HillClimbSettings {
     /// Probability that a weight gets Cauchy noise. Default 0.2 `[chosen]`.
     /// Bounds: [0, 1].
     pub p_noise: f64,
-    /// Scale of that noise (alpha). Default 1 `[chosen]`. Bounds: (0, 1e6].
+    /// Scale of that noise (alpha). Default 0.3 `[chosen]`, ESP's own
+    /// Cauchy scale (the paper's parallel; docs/model.md, sweep S26).
+    /// Bounds: (0, 1e6].
     pub alpha: f64,
     /// Probability that a weight then changes sign. Default 0.05
     /// `[chosen]`. Bounds: [0, 1].
@@ -73,7 +75,7 @@ impl Default for HillClimbSettings {
             cycles: 2000,
             init_range: 6.0,
             p_noise: 0.2,
-            alpha: 1.0,
+            alpha: 0.3,
             p_flip: 0.05,
             anneal_noise: 0.999,
             anneal_alpha: 0.999,
@@ -422,7 +424,7 @@ mod tests {
         let hc = HillClimb::new(HillClimbSettings::default(), 1).unwrap();
         let rates = MutationRates {
             p_noise: 0.2,
-            alpha: 1.0,
+            alpha: 0.3,
             p_flip: 0.0,
         };
         let mut genes = vec![0.0; 50_000];
@@ -431,7 +433,7 @@ mod tests {
         assert!((9_600..10_400).contains(&noisy), "{noisy} of 50000, expected 10000");
         let rates = MutationRates {
             p_noise: 0.0,
-            alpha: 1.0,
+            alpha: 0.3,
             p_flip: 0.05,
         };
         let mut genes = vec![1.0; 50_000];

@@ -103,6 +103,9 @@ pub const CHANGES: &[Change] = &[
     first("esp.erase_at", r#""topology_change""#),
     changed("esp.erase_at", "8cf59c9", r#""burst""#),
     first("esp.relesion", r#""pending""#),
+    changed("problem.tasks.task2_spin", "", "1.0"),
+    first("hill_climb.alpha", "1.0"),
+    changed("hill_climb.alpha", "", "0.3"),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.
