@@ -150,6 +150,25 @@ fn the_symmetric_heading_file_repeats_the_records_of_the_model_before_the_positi
     assert_repeats_the_random_start_records(config, "symmetric-heading");
 }
 
+#[test]
+fn the_positive_heading_file_repeats_the_records_of_the_model_before_the_readings_of_esp_byte_for_byte() {
+    // Recorded by build 44b0cee, whose defaults the file pins: the
+    // hill-climber's first chosen mutation, and evolution from random starts.
+    let config = "configs/positive-heading.toml";
+    assert_repeats_the_golden_records(config, "positive-heading", &["baseline", "max-credit", "hill-climb"]);
+    assert_repeats_the_random_start_records(config, "positive-heading");
+    // Erasing the best network on a topology change only: with b = 5 the
+    // 120 generations hold bursts, lesion tests and erasures.
+    let dir = tempfile::tempdir().unwrap();
+    let frequent = dir.path().join("frequent-bursts.toml");
+    let text = std::fs::read_to_string(repo(config)).unwrap();
+    assert!(text.contains("\nstagnation = 50\n"), "{config} pins b = 50");
+    std::fs::write(&frequent, text.replace("\nstagnation = 50\n", "\nstagnation = 5\n")).unwrap();
+    for task in ["1", "2", "3"] {
+        assert_repeats_one_golden_record(&frequent, "positive-heading", "erase-best", "erase-best-b5", task);
+    }
+}
+
 /// Asserts that `config` with random starts repeats the records in
 /// `tests/golden/GOLDEN/random-init-tTASK.csv` on tasks 1 and 3 (the tasks
 /// the paper starts at random), byte for byte.
@@ -292,8 +311,8 @@ fn a_sweep_runs_a_grid_per_variant_and_reports_the_distance_and_sensitivity() {
     assert_eq!(variants.len(), 4);
     for v in variants {
         let d = &v["distance"];
-        // Table 1 (3) + Table 2 (5) + both burst totals: every term has runs here.
-        assert_eq!(d["terms"].as_array().unwrap().len(), 10, "{d}");
+        // Table 1 (3) + Table 2 (5) + both burst totals, their 8 sds and the burst ratio: every term has runs here.
+        assert_eq!(d["terms"].as_array().unwrap().len(), 19, "{d}");
         let total: f64 = d["terms"]
             .as_array()
             .unwrap()
@@ -301,5 +320,22 @@ fn a_sweep_runs_a_grid_per_variant_and_reports_the_distance_and_sensitivity() {
             .map(|t| t["z"].as_f64().unwrap().powi(2))
             .sum();
         assert!((total - d["total"].as_f64().unwrap()).abs() < 1e-9);
+        // The three parts add up to the total; each holds its own terms.
+        let parts: f64 = ["means", "spreads", "burst_ratio"]
+            .iter()
+            .map(|p| d[p].as_f64().unwrap())
+            .sum();
+        assert!((parts - total).abs() < 1e-9, "{d}");
+        let part_sum = |part: &str| -> f64 {
+            d["terms"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|t| t["part"] == part)
+                .map(|t| t["z"].as_f64().unwrap().powi(2))
+                .sum()
+        };
+        assert_eq!(part_sum("spread"), d["spreads"].as_f64().unwrap());
+        assert_eq!(part_sum("burst_ratio"), d["burst_ratio"].as_f64().unwrap());
     }
 }

@@ -62,12 +62,26 @@ fn valid_json() -> serde_json::Value {
     serde_json::to_value(&file).unwrap()
 }
 
+/// Makes `file` one of the build before commit `changed` (a file lacking
+/// a setting gets the value of the build that wrote it: `psa::defaults`).
+fn as_written_before(file: &mut serde_json::Value, changed: &str) {
+    let line = psa_esp::psa::defaults::BUILDS
+        .lines()
+        .find(|l| l.starts_with(changed))
+        .unwrap();
+    let parent = line.split(' ').nth(1).unwrap();
+    let provenance = file["provenance"].as_object_mut().unwrap();
+    provenance.remove("defaults");
+    provenance.insert("git_commit".into(), parent.into());
+}
+
 #[test]
 fn files_from_before_the_exponential_setting_load_with_the_accurate_one() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("net.json");
     let mut old = valid_json();
     old["problem"].as_object_mut().unwrap().remove("exponential").unwrap();
+    as_written_before(&mut old, "b450d06");
     std::fs::write(&path, old.to_string()).unwrap();
     let (file, _) = NetworkFile::load(&path).unwrap();
     assert_eq!(file.problem.unwrap().exponential, Exponential::Accurate);
@@ -88,6 +102,7 @@ fn files_from_before_the_readings_of_the_fitness_load_scored_on_their_evolution_
     let fitness = old["problem"]["fitness"].as_object_mut().unwrap();
     fitness.remove("scoring").unwrap();
     fitness.remove("state").unwrap();
+    as_written_before(&mut old, "d8e86a8");
     std::fs::write(&path, old.to_string()).unwrap();
     let problem = NetworkFile::load(&path).unwrap().0.problem.unwrap();
     assert_eq!(

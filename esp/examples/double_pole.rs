@@ -148,15 +148,55 @@ fn preset(name: &str) -> Result<EspSettings, String> {
     }
 }
 
-/// Parses `--name value` pairs and `--quiet`.
+/// The options that take a value.
+const VALUED: [&str; 12] = [
+    "--preset",
+    "--hidden",
+    "--subpop",
+    "--trials",
+    "--stagnation",
+    "--rule",
+    "--min-improvement",
+    "--burst",
+    "--topology",
+    "--budget",
+    "--seeds",
+    "--angle",
+];
+
+/// Parses `--name value` pairs and `--quiet` from the command line.
 fn options() -> Result<Options, Box<dyn Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let value = |name: &str| -> Option<&str> {
-        args.iter()
-            .position(|a| a == name)
-            .and_then(|i| args.get(i + 1))
-            .map(String::as_str)
-    };
+    parse(&args)
+}
+
+/// Parses `args`: every option one of [`VALUED`] with its value, or
+/// `--quiet`; anything else (a misspelt option, a value without its
+/// option, an option given twice) is an error naming it, so that no
+/// setting is silently left at its default.
+fn parse(args: &[String]) -> Result<Options, Box<dyn Error>> {
+    let mut given: Vec<(&str, &str)> = Vec::new();
+    let mut quiet = false;
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        if arg == "--quiet" {
+            quiet = true;
+            continue;
+        }
+        let Some(&name) = VALUED.iter().find(|&&n| n == arg) else {
+            return Err(format!(
+                "unknown argument {arg:?}; the options are {} and --quiet",
+                VALUED.join(", ")
+            )
+            .into());
+        };
+        let value = rest.next().ok_or_else(|| format!("{name} needs a value"))?;
+        if given.iter().any(|(n, _)| *n == name) {
+            return Err(format!("{name} is given twice").into());
+        }
+        given.push((name, value));
+    }
+    let value = |name: &str| given.iter().find(|(n, _)| *n == name).map(|(_, v)| *v);
     let number = |name: &str| -> Result<Option<f64>, Box<dyn Error>> {
         value(name)
             .map(|v| v.parse::<f64>().map_err(|e| format!("{name} {v:?}: {e}").into()))
@@ -180,6 +220,9 @@ fn options() -> Result<Options, Box<dyn Error>> {
     if let Some(v) = count("--stagnation")? {
         settings.stagnation = v;
     }
+    if let Some(v) = number("--min-improvement")? {
+        settings.stagnation_min_improvement = v;
+    }
     if let Some(rule) = value("--rule") {
         settings.stagnation_rule = match rule {
             "phase_best" => StagnationRule::PhaseBest,
@@ -201,12 +244,13 @@ fn options() -> Result<Options, Box<dyn Error>> {
             other => return Err(format!("--topology {other:?}: lesion or off").into()),
         };
     }
+    settings.validate().map_err(|e| e.to_string())?;
     Ok(Options {
         settings,
         seeds: count("--seeds")?.unwrap_or(50) as u64,
         budget: count("--budget")?.unwrap_or(200_000) as u64,
         angle_degrees: number("--angle")?.unwrap_or(4.5),
-        quiet: args.iter().any(|a| a == "--quiet"),
+        quiet,
     })
 }
 
@@ -242,4 +286,32 @@ fn main() -> Result<(), Box<dyn Error>> {
         options.budget,
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(text: &str) -> Vec<String> {
+        text.split_whitespace().map(String::from).collect()
+    }
+
+    #[test]
+    fn every_documented_option_acts_and_any_other_is_refused() {
+        let o = parse(&args("--preset tuned --stagnation 50 --min-improvement 0.5 --quiet")).unwrap();
+        assert_eq!(o.settings.stagnation, 50);
+        assert_eq!(o.settings.stagnation_min_improvement, 0.5);
+        assert_eq!(o.settings.trials_per_neuron, 2);
+        assert!(o.quiet);
+        for (bad, needle) in [
+            ("--stagnaton 50", "--stagnaton"),
+            ("--stagnation", "needs a value"),
+            ("--seeds 3 --seeds 4", "twice"),
+            ("50", "\"50\""),
+            ("--min-improvement x", "--min-improvement"),
+        ] {
+            let err = parse(&args(bad)).err().expect(bad).to_string();
+            assert!(err.contains(needle), "{bad}: {err}");
+        }
+    }
 }

@@ -42,7 +42,9 @@ pub struct HillClimbSettings {
     /// Probability that a weight gets Cauchy noise. Default 0.2 `[chosen]`.
     /// Bounds: [0, 1].
     pub p_noise: f64,
-    /// Scale of that noise (alpha). Default 1 `[chosen]`. Bounds: (0, 1e6].
+    /// Scale of that noise (alpha). Default 0.3 `[chosen]`, ESP's own
+    /// Cauchy scale (the paper's parallel; docs/model.md, sweep S26).
+    /// Bounds: (0, 1e6].
     pub alpha: f64,
     /// Probability that a weight then changes sign. Default 0.05
     /// `[chosen]`. Bounds: [0, 1].
@@ -73,7 +75,7 @@ impl Default for HillClimbSettings {
             cycles: 2000,
             init_range: 6.0,
             p_noise: 0.2,
-            alpha: 1.0,
+            alpha: 0.3,
             p_flip: 0.05,
             anneal_noise: 0.999,
             anneal_alpha: 0.999,
@@ -125,12 +127,32 @@ pub struct MutationRates {
     pub p_flip: f64,
 }
 
-/// A hill-climbing run: settings, seed and when to stop early.
+/// A hill-climbing run: settings, seed and when to stop early. Read from
+/// JSON it is checked as [`HillClimb::new`] checks it; the seed is written
+/// as a string (a number is read too).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "UncheckedHillClimb")]
 pub struct HillClimb {
     settings: HillClimbSettings,
+    #[serde(with = "crate::rng::u64_string")]
     seed: u64,
     stop: StopAt,
+}
+
+/// A [`HillClimb`] as read, before its settings are checked.
+#[derive(Deserialize)]
+struct UncheckedHillClimb {
+    settings: HillClimbSettings,
+    #[serde(with = "crate::rng::u64_string")]
+    seed: u64,
+    stop: StopAt,
+}
+
+impl TryFrom<UncheckedHillClimb> for HillClimb {
+    type Error = SettingsError;
+    fn try_from(raw: UncheckedHillClimb) -> Result<HillClimb, SettingsError> {
+        Ok(HillClimb::new(raw.settings, raw.seed)?.stop_at(raw.stop))
+    }
 }
 
 impl HillClimb {
@@ -402,7 +424,7 @@ mod tests {
         let hc = HillClimb::new(HillClimbSettings::default(), 1).unwrap();
         let rates = MutationRates {
             p_noise: 0.2,
-            alpha: 1.0,
+            alpha: 0.3,
             p_flip: 0.0,
         };
         let mut genes = vec![0.0; 50_000];
@@ -411,7 +433,7 @@ mod tests {
         assert!((9_600..10_400).contains(&noisy), "{noisy} of 50000, expected 10000");
         let rates = MutationRates {
             p_noise: 0.0,
-            alpha: 1.0,
+            alpha: 0.3,
             p_flip: 0.05,
         };
         let mut genes = vec![1.0; 50_000];

@@ -66,7 +66,7 @@ mod subpop;
 pub use any_run::AnyRun;
 pub use ask::{AskPurpose, AskTell, Asked, Ticket};
 pub use error::{RunError, SettingsError};
-pub use esp::{BurstMode, Credit, Esp, EspRun, EspSettings, Sampling, StagnationRule, TopologyMode};
+pub use esp::{BurstMode, Credit, EraseAt, Esp, EspRun, EspSettings, Relesion, Sampling, StagnationRule, TopologyMode};
 pub use evaluator::{evaluate_all, evaluate_each, evaluate_each_part, Evaluator, FnEvaluator, Part};
 pub use hill_climb::{HillClimb, HillClimbRun, HillClimbSettings, MutationRates};
 pub use limits::{

@@ -75,6 +75,35 @@ pub fn expand(seed: u64) -> [u64; 4] {
     [0, 1, 2, 3].map(|i| mix(seed.wrapping_add(i)))
 }
 
+/// A `u64` (a seed) written as a decimal string, read from a string or a
+/// number: JSON tools that read numbers as doubles (jq, JavaScript,
+/// Python's `float`) lose digits above 2^53. Use with
+/// `#[serde(with = "esp_neuroevolution::rng::u64_string")]`.
+pub mod u64_string {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    /// Writes `value` as a decimal string.
+    pub fn serialize<S: Serializer>(value: &u64, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(value)
+    }
+
+    /// Reads a `u64` from a decimal string or a number.
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<u64, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Either {
+            Number(u64),
+            Text(String),
+        }
+        match Either::deserialize(deserializer)? {
+            Either::Number(n) => Ok(n),
+            Either::Text(text) => text
+                .parse()
+                .map_err(|_| serde::de::Error::custom(format!("{text:?} is not a whole number in [0, 2^64)"))),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -82,11 +82,22 @@ fn new_run_id() -> u64 {
 /// A run of search `A` under way, as a state machine driven by ask and
 /// tell: its whole state ([`Saved`]), which serde saves and restores (a
 /// restored run goes on as the saved one would have, bit for bit), and its
-/// identity in its tickets (a restored run has a new one).
-#[derive(Debug, Clone)]
+/// identity in its tickets (a restored run, and a clone, has a new one).
+#[derive(Debug)]
 pub(crate) struct Driver<A: Search> {
     saved: Saved<A>,
     id: u64,
+}
+
+/// A clone is a run of its own: it may diverge from the original, so the
+/// tickets of one are foreign to the other.
+impl<A: Search> Clone for Driver<A> {
+    fn clone(&self) -> Driver<A> {
+        Driver {
+            saved: self.saved.clone(),
+            id: new_run_id(),
+        }
+    }
 }
 
 /// What a run's save holds: all of it but its identity.

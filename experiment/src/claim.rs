@@ -101,7 +101,7 @@ pub enum Attempt {
 /// Claims the run in `folder` (created if need be), taking over a claim
 /// whose process is gone or that is older than `timeout`.
 pub fn claim(folder: &Path, timeout: Duration) -> Result<Attempt> {
-    std::fs::create_dir_all(folder).with_context(|| format!("cannot create {}", folder.display()))?;
+    crate::io::create_output_dir(folder)?;
     let path = folder.join(CLAIM_FILE);
     // Each pass either claims, finds a live claim, or clears a stale one;
     // only racing processes make it go round more than twice.
@@ -132,6 +132,22 @@ pub fn claim(folder: &Path, timeout: Duration) -> Result<Attempt> {
         "{}: could not claim the run (other processes keep claiming and clearing it)",
         path.display()
     )
+}
+
+/// Removes the claim in the folder of a finished run when its process is
+/// gone or it is older than `timeout` (a grid killed while writing, or a
+/// lockstep grid killed before releasing its claims, leaves them): a
+/// finished run holds only its documented files. A live claim is left.
+pub fn clear_stale(folder: &Path, timeout: Duration) -> Result<()> {
+    let path = folder.join(CLAIM_FILE);
+    let Ok(existing) = crate::io::read_input_text(&path) else {
+        return Ok(());
+    };
+    match serde_json::from_str::<ClaimRecord>(&existing) {
+        Ok(record) if record.stale(timeout).is_some() => take_over(&path, &existing),
+        Err(_) if modified_before(&path, Duration::from_secs(60)) => take_over(&path, &existing),
+        _ => Ok(()),
+    }
 }
 
 /// Clears the stale claim `path` whose text was `stale`: it is renamed

@@ -86,7 +86,7 @@ pub enum Preset {
     MaxCredit,
     /// No lesion tests (Table 6).
     LesionOff,
-    /// Erase the best network on topology changes (Table 6).
+    /// Erase the best network at every burst mutation (Table 6; `esp.erase_at`).
     EraseBest,
     /// The hill-climber (Table 7).
     HillClimb,

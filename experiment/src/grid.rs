@@ -26,6 +26,14 @@ pub const GRID_FORMAT: &str = "psa-esp-grid";
 /// Its version.
 pub const GRID_VERSION: u32 = 1;
 
+/// The settings a grid sets for all its runs, and the option that sets
+/// them: a grid's overrides may not set them.
+pub const GRID_KEYS: [(&str, &str); 3] = [
+    ("problem.backend", "--backend"),
+    ("esp.generations", "--generations"),
+    ("hill_climb.cycles", "--generations"),
+];
+
 /// The most seeds per configuration and task (the paper: 30).
 pub const MAX_SEEDS: u64 = 10_000;
 
@@ -179,12 +187,61 @@ impl GridSpec {
         Ok(())
     }
 
-    /// Every run of the grid, in a fixed order (configuration, task, seed).
+    /// The checks of a grid about to be written, beyond [`GridSpec::validate`]
+    /// (which grids an earlier build wrote must pass to be read): no
+    /// configuration or task listed twice (each run would be counted
+    /// twice), no setting in the overrides that the grid sets itself (it
+    /// would do nothing), and every configuration valid on every task it
+    /// runs (random starts on task 2), so that nothing fails after the
+    /// first run has started.
+    pub fn check_new(&self) -> Result<()> {
+        self.validate()?;
+        for (text, what) in [(&self.overrides, "configuration"), (&self.rescoring, "rescoring")] {
+            let Some(text) = text else { continue };
+            let table: toml::Table = toml::from_str(text).with_context(|| format!("the grid's {what}"))?;
+            for (key, option) in GRID_KEYS {
+                let mut parts = key.split('.');
+                let (section, name) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
+                if table.get(section).and_then(|t| t.get(name)).is_some() {
+                    bail!("{key} in the grid's {what}: a grid sets it for all its runs (use {option})");
+                }
+            }
+        }
+        for &config in &self.configs {
+            let run = self.run_config(config)?;
+            for &task in &self.tasks {
+                if config.applies_to(task) {
+                    run.problem
+                        .for_task(task)
+                        .with_context(|| format!("configuration {config} on task {task}"))?;
+                }
+            }
+        }
+
+        for (i, config) in self.configs.iter().enumerate() {
+            if self.configs[..i].contains(config) {
+                bail!("configuration {config} is listed twice");
+            }
+        }
+        for (i, task) in self.tasks.iter().enumerate() {
+            if self.tasks[..i].contains(task) {
+                bail!("task {task} is listed twice");
+            }
+        }
+        Ok(())
+    }
+
+    /// Every run of the grid, in a fixed order (configuration, task, seed),
+    /// each once (a `grid.json` of an earlier build may list a
+    /// configuration or task twice).
     pub fn runs(&self) -> Vec<RunKey> {
         let mut runs = Vec::new();
-        for &config in &self.configs {
-            for &task in &self.tasks {
-                if !config.applies_to(task) {
+        for (i, &config) in self.configs.iter().enumerate() {
+            if self.configs[..i].contains(&config) {
+                continue;
+            }
+            for (j, &task) in self.tasks.iter().enumerate() {
+                if !config.applies_to(task) || self.tasks[..j].contains(&task) {
                     continue;
                 }
                 for seed in 1..=self.seeds {
@@ -208,6 +265,56 @@ impl GridSpec {
         c.validate()
             .with_context(|| format!("configuration {config} with the grid's overrides"))?;
         Ok(c)
+    }
+
+    /// The configuration a run of `config` had in this grid when the build
+    /// at `placement` wrote it: [`GridSpec::run_config`] with every setting
+    /// of the table of defaults (`psa::defaults`) at that build's value,
+    /// under the grid's overrides. An error when the build cannot be placed.
+    pub fn run_config_at(&self, config: GridConfig, placement: &crate::psa::defaults::Placement) -> Result<RunConfig> {
+        let mut table = toml::Table::try_from(RunConfig::default())?;
+        for row in crate::psa::defaults::CHANGES {
+            let value = crate::psa::defaults::value_at(row.key, placement).map_err(anyhow::Error::msg)?;
+            if let Some(value) = value {
+                let value: toml::Value = serde_json::from_value(value)?;
+                set_leaf(&mut table, row.key, value);
+            }
+        }
+        if let Some(text) = &self.overrides {
+            let overrides: toml::Table = toml::from_str(text).context("the grid's configuration overrides")?;
+            super::config::merge(&mut table, overrides);
+        }
+        let base: RunConfig = table.try_into()?;
+        let mut c = config.apply(base);
+        c.esp.generations = self.generations;
+        c.hill_climb.cycles = self.generations;
+        c.problem.backend = self.backend;
+        Ok(c)
+    }
+
+    /// The settings `grid.json` states itself for a run of `config`: its
+    /// overrides, those the configuration's own change sets, generations
+    /// and backend (what [`Judge::Read`] checks a run against).
+    pub fn stated_keys(&self, config: GridConfig) -> Result<Vec<String>> {
+        let mut keys: Vec<String> = GRID_KEYS.iter().map(|(k, _)| k.to_string()).collect();
+        let base = match &self.overrides {
+            Some(text) => {
+                let mut set = Vec::new();
+                leaves(
+                    &toml::from_str(text).context("the grid's configuration overrides")?,
+                    "",
+                    &mut set,
+                );
+                keys.extend(set.into_iter().map(|(k, _)| k));
+                RunConfig::baseline_with(text).context("the grid's configuration overrides")?
+            }
+            None => RunConfig::default(),
+        };
+        let (mut before, mut after) = (Vec::new(), Vec::new());
+        leaves(&toml::Table::try_from(&base)?, "", &mut before);
+        leaves(&toml::Table::try_from(config.apply(base))?, "", &mut after);
+        keys.extend(after.into_iter().filter(|kv| !before.contains(kv)).map(|(k, _)| k));
+        Ok(keys)
     }
 
     /// The configuration `config`'s champions are tested and scored with:
@@ -252,10 +359,29 @@ pub fn run_dir(dir: &Path, key: &RunKey) -> PathBuf {
 /// The file whose presence marks a run finished (written last).
 pub const FINISHED_MARKER: &str = "robustness.json";
 
+/// How a run folder is judged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Judge {
+    /// To resume the grid: the run's configuration must be the one this
+    /// build gives it (else the error names the first setting that differs
+    /// and the build that wrote the run).
+    Resume,
+    /// To read the grid (`report`, `rescore`): the run's own files are the
+    /// truth, so a grid any build of this tool wrote reads; the run must
+    /// agree with the grid on what `grid.json` states itself (its
+    /// overrides, the configuration's own change, generations, backend).
+    Read,
+}
+
+/// Judges a run folder for resuming ([`Judge::Resume`]); see [`judge_run`].
+pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus> {
+    judge_run(dir, spec, key, Judge::Resume)
+}
+
 /// Judges a run folder: missing, unfinished (to be run again), finished,
 /// or an error naming the folder when it holds another configuration or a
 /// damaged file.
-pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus> {
+pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Result<RunStatus> {
     let folder = run_dir(dir, key);
     if !folder.exists() {
         return Ok(RunStatus::Missing);
@@ -265,17 +391,72 @@ pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus
         // Killed before its first file: nothing of value in it.
         return Ok(RunStatus::Unfinished);
     }
-    let text = crate::io::read_input(&config_path, "run configuration")?;
     let expected = spec.run_config(key.config)?;
-    let found = RunConfig::default()
-        .with_overrides(&text)
-        .with_context(|| format!("{}: damaged configuration", config_path.display()))?;
-    if found != expected {
-        bail!(
-            "{}: holds a different configuration than {} in this grid (another grid's run?); move it away or use another output directory",
-            folder.display(),
-            key.config
-        );
+    match judge {
+        Judge::Resume => {
+            let found = run_folder_config(&folder)?;
+            let differ = differences(&found, &expected)?;
+            if !differ.is_empty() {
+                let shown: Vec<String> = differ
+                    .iter()
+                    .map(|(setting, there, here)| format!("{setting} = {there} there, {here} in this build"))
+                    .collect();
+                bail!(
+                    "{}: holds a different configuration than {} in this grid ({}): {}; a run of another grid, or of this grid under an earlier build's defaults: `report` reads it, and resuming needs the build that wrote it, or another output directory",
+                    folder.display(),
+                    key.config,
+                    folder_build(&folder),
+                    shown.join("; ")
+                );
+            }
+        }
+        Judge::Read => {
+            let found = run_folder_config(&folder)?;
+            // The run as its own build made it: this grid under that build's
+            // defaults (`psa::defaults`); every setting must agree.
+            if let Ok(at_build) = spec.run_config_at(key.config, &folder_placement(&folder)) {
+                let differ = differences(&found, &at_build)?;
+                if !differ.is_empty() {
+                    let shown: Vec<String> = differ
+                        .iter()
+                        .map(|(setting, there, here)| format!("{setting} = {there} there, {here} in this grid"))
+                        .collect();
+                    bail!(
+                        "{}: holds a different configuration than {} in this grid under the defaults of its build ({}): {} (another grid's run?); move it away",
+                        folder.display(),
+                        key.config,
+                        folder_build(&folder),
+                        shown.join("; ")
+                    );
+                }
+            }
+            // A build that cannot be placed: every setting whose default never
+            // changed (no row in `psa::defaults`) holds at any build.
+            let changed_ever = |setting: &str| crate::psa::defaults::CHANGES.iter().any(|c| c.key == setting);
+            if let Some((setting, there, here)) = differences(&found, &expected)?
+                .into_iter()
+                .find(|(setting, _, _)| !changed_ever(setting))
+            {
+                bail!(
+                    "{}: holds a different configuration than {} in this grid: {setting} = {there} there, {here} at every build (another grid's run?); move it away",
+                    folder.display(),
+                    key.config,
+                );
+            }
+            // And the settings grid.json states.
+            for setting in spec.stated_keys(key.config)? {
+                let (there, here) = (leaf(&found, &setting)?, leaf(&expected, &setting)?);
+                if there != here {
+                    bail!(
+                        "{}: holds a different configuration than {} in this grid: {setting} = {} there, {} in grid.json (another grid's run?); move it away",
+                        folder.display(),
+                        key.config,
+                        there.map_or("nothing".into(), |v| v.to_string()),
+                        here.map_or("nothing".into(), |v| v.to_string())
+                    );
+                }
+            }
+        }
     }
     if !folder.join(FINISHED_MARKER).exists() {
         return Ok(RunStatus::Unfinished);
@@ -290,6 +471,122 @@ pub fn run_status(dir: &Path, spec: &GridSpec, key: &RunKey) -> Result<RunStatus
     }
     check_finished_files(&folder, spec)?;
     Ok(RunStatus::Finished)
+}
+
+/// The configuration of the run in `folder` (its `config.toml`), each
+/// setting it lacks given the value the build that wrote it used (named
+/// by its `run.json`; see `psa::defaults`).
+pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
+    let path = folder.join("config.toml");
+    let text = crate::io::read_input(&path, "run configuration")?;
+    let damaged = || format!("{}: damaged configuration", path.display());
+    let table: toml::Table = toml::from_str(&text).with_context(damaged)?;
+    let mut doc = serde_json::to_value(&table).with_context(damaged)?;
+    let placement = folder_placement(folder);
+    crate::psa::defaults::fill(&mut doc, "", &placement).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let table: toml::Table = serde_json::from_value(doc).with_context(damaged)?;
+    RunConfig::default()
+        .with_overrides(&toml::to_string(&table)?)
+        .with_context(damaged)
+}
+
+/// Where the build that wrote the run in `folder` stands in the table of
+/// defaults: by its `run.json`'s `build`.
+fn folder_placement(folder: &Path) -> crate::psa::defaults::Placement {
+    use crate::psa::defaults::Placement;
+    let build = crate::io::read_input_text(&folder.join("run.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .and_then(|run| run.get("build").cloned());
+    match build {
+        Some(serde_json::Value::Object(build)) => Placement::of_json(Some(&build)),
+        _ => Placement::Unknown("its run.json, which names its build, is not written (yet)".into()),
+    }
+}
+
+/// The build that wrote the run in `folder`, in words.
+fn folder_build(folder: &Path) -> String {
+    let build = crate::io::read_input_text(&folder.join("run.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .and_then(|run| run.get("build").cloned());
+    match build {
+        Some(build) => format!(
+            "the run was written by version {} commit {}",
+            build.get("tool_version").and_then(|v| v.as_str()).unwrap_or("?"),
+            build.get("git_commit").and_then(|v| v.as_str()).unwrap_or("?")
+        ),
+        None => "the run is unfinished: no run.json names its build".into(),
+    }
+}
+
+/// Sets the dotted `key` of `table` to `value`, making the tables on the way.
+fn set_leaf(table: &mut toml::Table, key: &str, value: toml::Value) {
+    let mut parts: Vec<&str> = key.split('.').collect();
+    let Some(last) = parts.pop() else {
+        return;
+    };
+    let mut at = table;
+    for part in parts {
+        let entry = at
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        let Some(inner) = entry.as_table_mut() else {
+            return;
+        };
+        at = inner;
+    }
+    at.insert(last.to_string(), value);
+}
+
+/// Every leaf setting of a TOML table, as dotted keys with their values.
+fn leaves(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
+    for (key, value) in table {
+        let path = format!("{prefix}{key}");
+        match value {
+            toml::Value::Table(inner) => leaves(inner, &format!("{path}."), out),
+            other => out.push((path, other.clone())),
+        }
+    }
+}
+
+/// The value of the dotted `key` in `config` (`None` when absent).
+fn leaf(config: &RunConfig, key: &str) -> Result<Option<toml::Value>> {
+    let table = toml::Table::try_from(config)?;
+    let mut at = &table;
+    let mut parts: Vec<&str> = key.split('.').collect();
+    let last = parts.pop().unwrap_or("");
+    for part in parts {
+        match at.get(part).and_then(|v| v.as_table()) {
+            Some(inner) => at = inner,
+            None => return Ok(None),
+        }
+    }
+    Ok(at.get(last).cloned())
+}
+
+/// Every setting in which `a` and `b` differ: its key and both values.
+pub fn differences(a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, String)>> {
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    leaves(&toml::Table::try_from(a)?, "", &mut left);
+    leaves(&toml::Table::try_from(b)?, "", &mut right);
+    let mut differ = Vec::new();
+    for (key, value) in &left {
+        let other = right.iter().find(|(k, _)| k == key).map(|(_, v)| v);
+        if other != Some(value) {
+            differ.push((
+                key.clone(),
+                value.to_string(),
+                other.map_or("nothing".into(), |v| v.to_string()),
+            ));
+        }
+    }
+    for (key, value) in &right {
+        if !left.iter().any(|(k, _)| k == key) {
+            differ.push((key.clone(), "nothing".into(), value.to_string()));
+        }
+    }
+    Ok(differ)
 }
 
 /// Parses the files of a finished run, so that a damaged one is never

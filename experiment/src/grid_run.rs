@@ -48,6 +48,7 @@ pub struct FinishedRun {
 /// evaluated on `path`.
 pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey, path: &EvalPath) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
+    crate::lockstep::check_checkpoint(&folder)?;
     let config = spec.run_config(key.config)?;
     let seed = run_seed(key);
     let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, path, |_| {})
@@ -83,6 +84,10 @@ pub(crate) fn test_and_mark(
         outcome.save(&RunFiles::in_dir(&folder).summary)?;
         check.verify(&folder.display().to_string())?;
     }
+    // A checkpoint an earlier lockstep process left (this run ran again
+    // from the start, or resumed from it): a finished run holds only its
+    // documented files.
+    crate::lockstep::remove_checkpoint(&folder)?;
     mark_finished(&folder, &robustness)?;
     Ok(FinishedRun { key: *key, outcome })
 }
@@ -97,7 +102,16 @@ pub(crate) fn score_champion(
     seed: u64,
     path: &EvalPath,
 ) -> Result<(crate::network::Network, crate::RunConfig, Robustness)> {
-    let scoring = spec.scoring_config(key.config)?;
+    // The run's own configuration (a grid an earlier build wrote is
+    // re-scored under the defaults it was evolved with), with the grid's
+    // rescoring laid over it.
+    let run = crate::grid::run_folder_config(folder)?;
+    let scoring = match &spec.rescoring {
+        Some(text) => run
+            .with_overrides(text)
+            .with_context(|| format!("configuration {} with the grid's rescoring", key.config))?,
+        None => run,
+    };
     let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
     let mut robustness = test_robustness(
         &champion,

@@ -148,7 +148,16 @@ pub(super) fn replicate_lockstep(
 fn save_checkpoints(runs: &[AnyRun], files: &[PathBuf]) {
     runs.par_iter().zip(files).with_max_len(1).for_each(|(run, file)| {
         if run.ending().is_none() {
-            let saved = serde_json::to_vec(run).map_err(anyhow::Error::from);
+            let saved = serde_json::to_vec(run).map_err(anyhow::Error::from).and_then(|json| {
+                // One that could not be read back is not written.
+                anyhow::ensure!(
+                    json.len() as u64 <= crate::io::MAX_INPUT_BYTES,
+                    "the run's state takes {} bytes, more than the {} an input file may",
+                    json.len(),
+                    crate::io::MAX_INPUT_BYTES
+                );
+                Ok(json)
+            });
             if let Err(e) = saved.and_then(|json| crate::io::write_atomic(file, &json)) {
                 log::warn!("cannot save {}: {e:#}", file.display());
             }
@@ -156,8 +165,28 @@ fn save_checkpoints(runs: &[AnyRun], files: &[PathBuf]) {
     });
 }
 
+/// Refuses a run whose checkpoint is there but not a regular file (a
+/// directory, a FIFO, a link): it could be neither read nor removed.
+pub(crate) fn check_checkpoint(folder: &Path) -> Result<()> {
+    let file = folder.join(CHECKPOINT);
+    match std::fs::symlink_metadata(&file) {
+        Ok(meta) if !meta.file_type().is_file() => anyhow::bail!(
+            "{}: it is not a regular file (a {}); remove it to run the run",
+            file.display(),
+            if meta.is_dir() {
+                "directory"
+            } else if meta.file_type().is_symlink() {
+                "symbolic link"
+            } else {
+                "FIFO, device or socket"
+            }
+        ),
+        _ => Ok(()),
+    }
+}
+
 /// Removes a finished run's checkpoint, if any.
-fn remove_checkpoint(folder: &Path) -> Result<()> {
+pub(crate) fn remove_checkpoint(folder: &Path) -> Result<()> {
     match std::fs::remove_file(folder.join(CHECKPOINT)) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
             Err(e).with_context(|| format!("cannot remove {}", folder.join(CHECKPOINT).display()))
@@ -167,14 +196,30 @@ fn remove_checkpoint(folder: &Path) -> Result<()> {
 }
 
 /// The run that `folder`'s checkpoint saved, when there is one of the
-/// same search as `fresh` (else `fresh`, a checkpoint that cannot be read
-/// or is of another search being ignored).
-fn resume(folder: &Path, fresh: AnyRun) -> AnyRun {
+/// same search as `fresh` (else `fresh`: a checkpoint that does not parse
+/// or is of another search is ignored, with a warning). A checkpoint is an
+/// input file as any other (docs/limits.md): anything but a regular file
+/// (a FIFO, a link, a directory, a device) or a file over
+/// [`crate::io::MAX_INPUT_BYTES`] is refused, and the run with it, by an
+/// error naming it, before the run starts.
+fn resume(folder: &Path, fresh: AnyRun) -> Result<AnyRun> {
     let file = folder.join(CHECKPOINT);
-    let Ok(json) = std::fs::read(&file) else {
-        return fresh;
-    };
-    match serde_json::from_slice::<AnyRun>(&json) {
+    match std::fs::symlink_metadata(&file) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(fresh),
+        // Anything else but a regular file is refused by read_input_text
+        // below, naming what it is; a link is refused even when it points at
+        // a regular file.
+        Ok(meta) if meta.file_type().is_symlink() => {
+            anyhow::bail!(
+                "{}: it is a symbolic link, not a regular file; remove it to start the run afresh",
+                file.display()
+            );
+        }
+        _ => {}
+    }
+    let json = crate::io::read_input_text(&file)
+        .map_err(|problem| anyhow::anyhow!("{}: {problem}; remove it to start the run afresh", file.display()))?;
+    Ok(match serde_json::from_str::<AnyRun>(&json) {
         Ok(saved) if saved.same_search(&fresh) => {
             log::info!(
                 "{}: resumed after generation {}",
@@ -191,7 +236,7 @@ fn resume(folder: &Path, fresh: AnyRun) -> AnyRun {
             log::warn!("{}: cannot be read ({e}), ignored", file.display());
             fresh
         }
-    }
+    })
 }
 
 /// Starts run `key` of grid `grid` (of definition `spec`) in `folder` (its
@@ -205,6 +250,7 @@ fn begin(
     path: &EvalPath,
     evaluators: &mut Vec<CellEvaluator>,
 ) -> Result<(Started, AnyRun)> {
+    check_checkpoint(folder)?;
     let config = spec.run_config(key.config)?;
     let seed = run_seed(key);
     let mut start = RunStart::new(&config, folder)?;
@@ -231,7 +277,7 @@ fn begin(
             .start(inputs, outputs)?
             .into(),
     };
-    let search = resume(folder, fresh);
+    let search = resume(folder, fresh)?;
     for record in search.records() {
         start.record(record);
     }

@@ -9,11 +9,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use rayon::prelude::*;
 
 use super::claim::{claim, Attempt, Claim, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
-use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
+use super::grid::{judge_run, run_dir, run_status, GridSpec, Judge, RunKey, RunStatus};
 use super::grid_run::{run_one, FinishedRun};
 use super::lockstep::{replicate_lockstep, Executor};
 use super::shard::Shard;
@@ -86,7 +86,7 @@ pub struct ReplicateSummary {
 /// processes starting together, exactly one writes it); an existing grid
 /// must have the same definition. Returns the runs of `shard` still to do,
 /// and how many of its runs are finished.
-pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard) -> Result<(Vec<RunKey>, usize)> {
+pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Result<(Vec<RunKey>, usize)> {
     spec.validate()?;
     let grid_file = super::grid::grid_file(dir);
     // `runs/` first: a grid's run folders appear only after its grid.json.
@@ -96,9 +96,14 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard) -> Result<(Vec<RunKey>
             dir.display()
         );
     }
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    crate::io::create_output_dir(dir)?;
     let mut json = serde_json::to_string_pretty(spec)?;
     json.push('\n');
+    // A new grid is checked whole before its first run (a re-scored grid's
+    // definition is its source's, read as written: `Judge::Read`).
+    if !grid_file.exists() && judge == Judge::Resume {
+        spec.check_new()?;
+    }
     if !grid_file.exists() && crate::io::create_new_atomic(&grid_file, json.as_bytes())? {
         // This process wrote grid.json.
     } else {
@@ -114,9 +119,16 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard) -> Result<(Vec<RunKey>
     let mut todo = Vec::new();
     let mut problems = Vec::new();
     let runs = shard.select(&spec.runs());
+    crate::io::remove_stale_temporaries(dir);
     for key in &runs {
-        match run_status(dir, spec, key) {
-            Ok(RunStatus::Finished) => {}
+        let folder = run_dir(dir, key);
+        crate::io::remove_stale_temporaries(&folder);
+        match judge_run(dir, spec, key, judge) {
+            Ok(RunStatus::Finished) => {
+                // What a killed process left in a finished run.
+                super::claim::clear_stale(&folder, DEFAULT_CLAIM_TIMEOUT)?;
+                super::lockstep::remove_checkpoint(&folder)?;
+            }
             Ok(RunStatus::Missing | RunStatus::Unfinished) => todo.push(*key),
             Err(e) => problems.push(format!("{e:#}")),
         }
@@ -223,7 +235,7 @@ pub fn replicate_grids(
     let mut totals = Vec::new();
     let mut skipped = Vec::new();
     for (grid, job) in grids.iter().enumerate() {
-        let (runs, finished) = prepare(job.dir, job.spec, job.shard)?;
+        let (runs, finished) = prepare(job.dir, job.spec, job.shard, Judge::Resume)?;
         totals.push(runs.len() + finished);
         skipped.push(finished);
         todo.extend(runs.into_iter().map(|key| (grid, key)));

@@ -24,13 +24,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
-use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
+use super::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
 use super::runs_table::{runs_csv, RUNS_CSV};
 use super::GridConfig;
 use crate::psa::Task;
 use crate::results::{load_run, GenerationRow, RunData};
 
-pub use distance::{Distance, Term};
+pub use distance::{Distance, Part, Term};
 pub use findings::{Finding, Rule, Verdict, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
 pub use paper::{
     paper_bursts, paper_bursts_per_run, paper_cell, PaperCell, PAPER_BURSTS, PAPER_BURST_RUNS, PAPER_RUNS_ALL,
@@ -167,7 +167,7 @@ impl GridResults {
         };
         for key in spec.runs() {
             let folder = run_dir(dir, &key);
-            let status = run_status(dir, &spec, &key).and_then(|status| match status {
+            let status = judge_run(dir, &spec, &key, Judge::Read).and_then(|status| match status {
                 RunStatus::Finished => load_run(&folder, &key).map(Some),
                 _ => {
                     results.incomplete.push(Incomplete {
@@ -244,6 +244,9 @@ impl ReportOutcome {
 /// outcome (and the Markdown), not as errors.
 pub fn write_report(dir: &Path, format: ReportFormat) -> Result<ReportOutcome> {
     let results = GridResults::load(dir)?;
+    // What an earlier report, killed while writing, left.
+    crate::io::remove_stale_temporaries(dir);
+    crate::io::remove_stale_temporaries(&dir.join("figures"));
     let mut report = Report::from_results(&results);
     let (links, figures, figure_problems) = figures::write_figures(&results, &dir.join("figures"));
     report.figures = links;

@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 
-use super::grid::{run_dir, run_status, GridSpec, RunKey, RunStatus};
+use super::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
 use super::grid_run::{mark_finished, run_seed, score_champion};
 use super::replicate::prepare;
 use super::shard::Shard;
@@ -63,6 +63,82 @@ pub fn rescored_spec(source: &GridSpec, overlay: &str, trials: Option<usize>) ->
     Ok(spec)
 }
 
+/// Refuses a rescoring setting that changes nothing the robustness tests
+/// fly on any run of `source` (input and output noise, random starts and
+/// trials are each test's own; the fitness evolved on is not the one
+/// scored unless the scoring is `evolution`): its results would be those
+/// of the source, marked re-scored. The error names the setting.
+/// Each configuration is judged on its first finished run in `dir` (its
+/// own configuration: a grid of an earlier build flew that build's
+/// defaults), else on the grid's definition.
+pub fn check_rescoring_acts(dir: &Path, source: &GridSpec, overlay: &str) -> Result<()> {
+    let added: toml::Table = toml::from_str(overlay).context("the rescoring settings")?;
+    let mut bases = Vec::new();
+    for &config in &source.configs {
+        let finished = source.runs().into_iter().find(|key| {
+            key.config == config && matches!(judge_run(dir, source, key, Judge::Read), Ok(RunStatus::Finished))
+        });
+        let run = match finished {
+            Some(key) => super::grid::run_folder_config(&run_dir(dir, &key))?,
+            None => source.run_config(config)?,
+        };
+        let scoring = match &source.rescoring {
+            Some(text) => run.with_overrides(text)?,
+            None => run,
+        };
+        bases.push((config, scoring));
+    }
+    check_each_setting_acts(source, &bases, &added)
+}
+
+fn check_each_setting_acts(
+    source: &GridSpec,
+    bases: &[(crate::GridConfig, crate::RunConfig)],
+    added: &toml::Table,
+) -> Result<()> {
+    fn leaves(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
+        for (key, value) in table {
+            match value {
+                toml::Value::Table(inner) => leaves(inner, &format!("{prefix}{key}."), out),
+                other => out.push((format!("{prefix}{key}"), other.clone())),
+            }
+        }
+    }
+    let mut settings = Vec::new();
+    leaves(added, "", &mut settings);
+    for (key, value) in settings {
+        let alone = format!("{key} = {value}");
+        let mut acts = false;
+        for (config, before) in bases {
+            let config = *config;
+            let after = before
+                .with_overrides(&alone)
+                .with_context(|| format!("the rescoring setting {alone}"))?;
+            for &task in source.tasks.iter().filter(|&&t| config.applies_to(t)) {
+                let tested = |c: &crate::RunConfig| super::robustness::tested_settings(&c.problem, task);
+                acts |= tested(before)? != tested(&after)?;
+            }
+        }
+        if !acts {
+            bail!(
+                "the rescoring setting {alone} changes nothing the robustness tests fly: they set their own input and output noise, random starts and trials, and score on fitness.scoring (the fitness evolved on only with scoring = \"evolution\")"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Refuses `out` when it is the grid `source` itself.
+pub fn check_out(source: &Path, out: &Path) -> Result<()> {
+    if std::fs::canonicalize(source).ok() == std::fs::canonicalize(out).ok() {
+        bail!(
+            "--out {} is the grid being re-scored; re-scoring writes a new grid folder",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
 /// Re-tests every finished run of the grid in `source` under `spec` (made
 /// by [`rescored_spec`]) into `out`, on `threads` threads (0: one per
 /// core): each run's evolution files copied, its `robustness.json` written
@@ -70,21 +146,16 @@ pub fn rescored_spec(source: &GridSpec, overlay: &str, trials: Option<usize>) ->
 pub fn rescore(source: &Path, out: &Path, spec: &GridSpec, threads: usize) -> Result<RescoreSummary> {
     let clock = Instant::now();
     let source_spec = GridSpec::load(source)?;
-    if std::fs::canonicalize(source).ok() == std::fs::canonicalize(out).ok() {
-        bail!(
-            "--out {} is the grid being re-scored; re-scoring writes a new grid folder",
-            out.display()
-        );
-    }
+    check_out(source, out)?;
     let mut finished = Vec::new();
     let mut unfinished = 0;
     for key in source_spec.runs() {
-        match run_status(source, &source_spec, &key)? {
+        match judge_run(source, &source_spec, &key, Judge::Read)? {
             RunStatus::Finished => finished.push(key),
             RunStatus::Missing | RunStatus::Unfinished => unfinished += 1,
         }
     }
-    let (todo, _) = prepare(out, spec, Shard::ALL)?;
+    let (todo, _) = prepare(out, spec, Shard::ALL, Judge::Read)?;
     let todo: Vec<RunKey> = todo.into_iter().filter(|k| finished.contains(k)).collect();
     let skipped = finished.len() - todo.len();
     let pool = crate::ode::thread_pool(threads)?;
@@ -107,11 +178,10 @@ pub fn rescore(source: &Path, out: &Path, spec: &GridSpec, threads: usize) -> Re
 /// its robustness tests under `spec`'s scoring.
 fn rescore_run(source: &Path, out: &Path, spec: &GridSpec, key: &RunKey) -> Result<()> {
     let (from, to) = (run_dir(source, key), run_dir(out, key));
-    std::fs::create_dir_all(&to).with_context(|| format!("cannot create {}", to.display()))?;
+    crate::io::create_output_dir(&to)?;
     for name in EVOLUTION_FILES {
-        let bytes =
-            std::fs::read(from.join(name)).with_context(|| format!("cannot read {}", from.join(name).display()))?;
-        crate::io::write_atomic(&to.join(name), &bytes)?;
+        let text = crate::io::read_input(&from.join(name), "run file")?;
+        crate::io::write_atomic(&to.join(name), text.as_bytes())?;
     }
     let (_, _, robustness) = score_champion(&to, spec, key, run_seed(key), &EvalPath::Fastest)
         .with_context(|| format!("re-scoring {}", from.display()))?;

@@ -57,6 +57,25 @@ pub struct Robustness {
     pub rescored: bool,
 }
 
+/// The settings of a champion's clean test under `problem` on `task`:
+/// scored with its scoring fitness, without noise (but for whether noise
+/// would reach the bias), from the task's start, one trial. The noisy and
+/// random-start tests are these with the paper's noise, random starts and
+/// the test's trials; so two problems with the same tested settings give
+/// the same robustness results.
+pub fn tested_settings(problem: &PsaSettings, task: Task) -> Result<PsaSettings> {
+    let scored = problem.scoring_for(task)?;
+    Ok(PsaSettings {
+        noise: NoiseSettings {
+            on_bias: problem.noise.on_bias,
+            ..NoiseSettings::default()
+        },
+        random_init: false,
+        trials: 1,
+        ..scored
+    })
+}
+
 /// Runs the robustness tests of `champion` on `task`. `problem` is the
 /// run's control problem, scored with its scoring fitness
 /// ([`PsaSettings::scoring_for`]); its noise, random initialisation and
@@ -72,16 +91,7 @@ pub fn test_robustness(
     seed: u64,
     path: &EvalPath,
 ) -> Result<Robustness> {
-    let scored = problem.scoring_for(task)?;
-    let base = PsaSettings {
-        noise: NoiseSettings {
-            on_bias: problem.noise.on_bias,
-            ..NoiseSettings::default()
-        },
-        random_init: false,
-        trials: 1,
-        ..scored
-    };
+    let base = tested_settings(problem, task)?;
     let scores =
         |settings: &PsaSettings, key: u64| trial_scores(settings, task, champion, &mut stream(seed, &[key]), path);
     let clean = mean_of_trials(&scores(&base, CLEAN)?);

@@ -126,6 +126,10 @@ struct LiveRecords {
 
 impl LiveRecords {
     fn create(path: &Path) -> LiveRecords {
+        // Never through a link or into a FIFO or device (docs/limits.md).
+        if crate::io::check_output_file(path).is_err() {
+            return LiveRecords { file: None };
+        }
         let file = std::fs::File::create(path).and_then(|mut f| {
             f.write_all((header(&RECORD_COLUMNS) + "\n").as_bytes())?;
             Ok(f)
@@ -190,7 +194,7 @@ impl RunStart {
     /// Checks `config`, makes `dir` and writes `config.toml` into it.
     pub fn new(config: &RunConfig, dir: &Path) -> Result<RunStart> {
         config.validate()?;
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create output directory {}", dir.display()))?;
+        crate::io::create_output_dir(dir)?;
         let files = RunFiles::in_dir(dir);
         write_atomic(&files.config, config.to_toml()?.as_bytes())?;
         let live = LiveRecords::create(&files.records);

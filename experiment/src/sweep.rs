@@ -25,6 +25,13 @@ pub const SWEEP_FORMAT: &str = "psa-esp-sweep";
 /// Its version.
 pub const SWEEP_VERSION: u32 = 1;
 
+/// The most variants a sweep may have.
+pub const MAX_VARIANTS: usize = 10_000;
+
+/// The longest variant folder name, in bytes: file systems allow 255; the
+/// rest is left for the temporary names written beside it.
+pub const MAX_VARIANT_NAME: usize = 200;
+
 /// One varied setting: a dotted key of the configuration file and its values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -114,15 +121,61 @@ pub fn parse_vary(text: &str) -> Result<Vary> {
     if values.iter().any(|v| v.is_empty()) {
         bail!("--vary {text:?}: an empty value");
     }
-    let mut seen = std::collections::HashSet::new();
-    if let Some(dup) = values.iter().find(|v| !seen.insert(v.as_str())) {
-        bail!("--vary {text:?}: the value {dup} is given twice");
+    for (i, value) in values.iter().enumerate() {
+        if let Some(earlier) = values[..i].iter().find(|e| same_value(e, value)) {
+            if earlier == value {
+                bail!("--vary {text:?}: the value {value} is given twice");
+            }
+            bail!("--vary {text:?}: the values {earlier} and {value} are the same value");
+        }
     }
     Ok(Vary {
         key: key.to_string(),
         values,
     })
 }
+
+/// Whether two TOML values (as [`toml_value`] writes them) are the same
+/// value: `1` and `1.0` are, as are arrays of such.
+fn same_value(a: &str, b: &str) -> bool {
+    fn parse(text: &str) -> Option<toml::Value> {
+        format!("v = {text}").parse::<toml::Table>().ok()?.remove("v")
+    }
+    fn same(a: &toml::Value, b: &toml::Value) -> bool {
+        use toml::Value::{Array, Float, Integer};
+        match (a, b) {
+            (Integer(x), Float(y)) | (Float(y), Integer(x)) => *x as f64 == *y,
+            (Float(x), Float(y)) => x == y,
+            (Array(x), Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same(x, y)),
+            _ => a == b,
+        }
+    }
+    match (parse(a), parse(b)) {
+        (Some(x), Some(y)) => same(&x, &y),
+        _ => a == b,
+    }
+}
+
+/// Refuses varied keys that overlap (`problem.fitness` beside
+/// `problem.fitness.scoring`: one would silently win over the other).
+fn check_keys(vary: &[Vary]) -> Result<()> {
+    for a in vary {
+        for b in vary {
+            if b.key.len() > a.key.len() && b.key.starts_with(&a.key) && b.key[a.key.len()..].starts_with('.') {
+                bail!(
+                    "--vary {} and --vary {} overlap: the first sets the table the second is in; vary the settings inside it instead",
+                    a.key,
+                    b.key
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The keys a grid sets itself (`--backend`, `--generations`): varied,
+/// they become the variant grid's own setting.
+const GRID_KEYS: [&str; 3] = ["problem.backend", "esp.generations", "hill_climb.cycles"];
 
 /// `text` as a TOML value: as written when it parses as one (numbers,
 /// booleans, arrays, quoted strings), else as a string (`phase_best`).
@@ -159,26 +212,87 @@ impl SweepSpec {
             vary,
             mode,
         };
-        spec.validate()?;
+        spec.check_new()?;
         Ok(spec)
     }
 
     /// Checks every variant's grid.
     pub fn validate(&self) -> Result<()> {
-        let variants = self.variants();
-        const MAX_VARIANTS: usize = 10_000;
-        if variants.len() > MAX_VARIANTS {
-            bail!(
-                "the sweep has {} variants; at most {MAX_VARIANTS} are allowed",
-                variants.len()
-            );
+        // Counted before any is built: four keys of 100 values each are
+        // 10^8 variants, which would not fit in memory.
+        let count = self.variant_count();
+        if count > MAX_VARIANTS as u128 {
+            bail!("the sweep has {count} variants; at most {MAX_VARIANTS} are allowed");
         }
-        for variant in &variants {
+        for variant in &self.variants() {
             self.variant_grid(variant)
                 .and_then(|grid| grid.validate())
                 .with_context(|| format!("variant {}", variant.name))?;
         }
         Ok(())
+    }
+
+    /// The checks of a sweep about to be run, beyond [`SweepSpec::validate`]
+    /// (which sweeps an earlier build wrote must pass to be read): no
+    /// overlapping keys, every variant grid's [`GridSpec::check_new`], and
+    /// no two variants that run the same runs.
+    pub fn check_new(&self) -> Result<()> {
+        self.validate()?;
+        check_keys(&self.vary)?;
+        let variants = self.variants();
+        // Variants that would run the same runs (a setting that does
+        // nothing, such as one a configuration overrides) are refused,
+        // naming the settings: else they are named as if they differed.
+        // One at a time, a value equal to the base's is a row of its own
+        // in the sensitivity table (the base's value, named).
+        let mut seen: std::collections::HashMap<String, &Variant> = std::collections::HashMap::new();
+        let mut base = None;
+        for variant in &variants {
+            let grid = self
+                .variant_grid(variant)
+                .and_then(|grid| grid.check_new().map(|_| grid))
+                .with_context(|| format!("variant {}", variant.name))?;
+            let identity = grid_identity(&grid)?;
+            if self.mode == SweepMode::OneAtATime {
+                if variant.settings.is_empty() {
+                    base = Some(identity);
+                    continue;
+                }
+                if base.as_ref() == Some(&identity) {
+                    continue;
+                }
+            }
+            if let Some(other) = seen.get(&identity) {
+                let differ: Vec<String> = variant
+                    .settings
+                    .iter()
+                    .filter(|s| !other.settings.contains(s))
+                    .map(|(k, v)| format!("{k} = {v}"))
+                    .collect();
+                bail!(
+                    "variants {} and {} run the same runs: {} changes nothing in this grid's configurations",
+                    other.name,
+                    variant.name,
+                    if differ.is_empty() {
+                        "the base".to_string()
+                    } else {
+                        differ.join(", ")
+                    }
+                );
+            }
+            seen.insert(identity, variant);
+        }
+        Ok(())
+    }
+
+    /// How many variants the sweep has, counted without building them
+    /// (saturating: far above [`MAX_VARIANTS`] is all that matters).
+    pub fn variant_count(&self) -> u128 {
+        let counts = self.vary.iter().map(|v| v.values.len() as u128);
+        match self.mode {
+            SweepMode::Combinations => counts.fold(1u128, |a, n| a.saturating_mul(n)),
+            SweepMode::OneAtATime => counts.fold(1u128, |a, n| a.saturating_add(n)),
+        }
     }
 
     /// The variants, in a fixed order.
@@ -221,7 +335,12 @@ impl SweepSpec {
             Some(text) => text.parse().context("the base configuration")?,
             None => toml::Table::new(),
         };
+        let mut grid = self.grid.clone();
         for (key, value) in &variant.settings {
+            if GRID_KEYS.contains(&key.as_str()) {
+                set_grid_key(&mut grid, key, value)?;
+                continue;
+            }
             set_dotted(&mut table, key, value)?;
         }
         // Unknown keys and bad values are named here, before any run.
@@ -229,7 +348,6 @@ impl SweepSpec {
             let settings: Vec<String> = variant.settings.iter().map(|(k, v)| format!("{k} = {v}")).collect();
             format!("settings {}", settings.join(", "))
         })?;
-        let mut grid = self.grid.clone();
         grid.overrides = (!table.is_empty()).then(|| toml::to_string(&table)).transpose()?;
         Ok(grid)
     }
@@ -280,10 +398,48 @@ fn variant_name(index: usize, width: usize, settings: &[(String, String)]) -> St
             }
         })
         .collect();
-    format!("v{index:0width$}-{clean}")
+    let mut name = format!("v{index:0width$}-{clean}");
+    if name.len() > MAX_VARIANT_NAME {
+        // The index alone tells variants apart; the settings in the name
+        // are for the eye (sweep.json and each grid.json hold them whole).
+        let keep = MAX_VARIANT_NAME - "+etc".len();
+        name.truncate(keep);
+        name.push_str("+etc");
+    }
+    name
 }
 
-/// Sets `a.b.c = value` in `table`, creating the tables on the way.
+/// What a grid runs, in one string: its definition but the overrides,
+/// and the whole configuration of each of its configurations.
+fn grid_identity(grid: &GridSpec) -> Result<String> {
+    let mut identity = serde_json::to_string(&GridSpec {
+        overrides: None,
+        ..grid.clone()
+    })?;
+    for &config in &grid.configs {
+        identity.push_str(&grid.run_config(config)?.to_toml()?);
+    }
+    Ok(identity)
+}
+
+/// Sets one of [`GRID_KEYS`] on the grid itself.
+fn set_grid_key(grid: &mut GridSpec, key: &str, value: &str) -> Result<()> {
+    let parsed: toml::Table = format!("v = {value}")
+        .parse()
+        .with_context(|| format!("{key} = {value}"))?;
+    let value = parsed["v"].clone();
+    if key == "problem.backend" {
+        grid.backend = value.try_into().with_context(|| format!("{key}: not a backend"))?;
+    } else {
+        let generations: usize = value.try_into().with_context(|| format!("{key}: not a count"))?;
+        grid.generations = generations;
+    }
+    Ok(())
+}
+
+/// Sets `a.b.c = value` in `table`, creating the tables on the way; a
+/// table value is laid over the table there, key by key, as a `--config`
+/// file is.
 fn set_dotted(table: &mut toml::Table, key: &str, value: &str) -> Result<()> {
     let parsed: toml::Table = format!("v = {value}")
         .parse()
@@ -300,7 +456,12 @@ fn set_dotted(table: &mut toml::Table, key: &str, value: &str) -> Result<()> {
             .as_table_mut()
             .with_context(|| format!("{key}: {part} is a value, not a table"))?;
     }
-    current.insert(last.to_string(), value);
+    match (current.get_mut(last), value) {
+        (Some(toml::Value::Table(existing)), toml::Value::Table(added)) => super::config::merge(existing, added),
+        (_, value) => {
+            current.insert(last.to_string(), value);
+        }
+    }
     Ok(())
 }
 
@@ -385,7 +546,8 @@ fn prepare(dir: &Path, spec: &SweepSpec) -> Result<()> {
             dir.display()
         );
     }
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    crate::io::create_output_dir(dir)?;
+    crate::io::remove_stale_temporaries(dir);
     let mut json = serde_json::to_string_pretty(spec)?;
     json.push('\n');
     if !sweep_file(dir).exists() && crate::io::create_new_atomic(&sweep_file(dir), json.as_bytes())? {

@@ -53,6 +53,12 @@ pub fn read_input_text(path: &Path) -> Result<String, String> {
 /// "a directory", "a FIFO (named pipe)", ...: what a file that is not a
 /// regular file is.
 fn describe_file_type(kind: &fs::FileType) -> &'static str {
+    if kind.is_symlink() {
+        return "a symbolic link";
+    }
+    if kind.is_file() {
+        return "a regular file";
+    }
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
@@ -73,6 +79,49 @@ fn describe_file_type(kind: &fs::FileType) -> &'static str {
     }
 }
 
+/// Checks that `path` may be written as an output file: a new name or a
+/// regular file, never a symbolic link, a FIFO, a device, a socket or a
+/// directory, since renaming a result over one would replace it (as root,
+/// `--out /dev/null` would turn `/dev/null` into a regular file) and
+/// writing through a link writes wherever it points. The error names the
+/// path and what it is.
+pub fn check_output_file(path: &Path) -> Result<()> {
+    match fs::symlink_metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e).with_context(|| format!("cannot write {}", path.display())),
+        Ok(meta) if meta.file_type().is_file() => Ok(()),
+        Ok(meta) => anyhow::bail!(
+            "cannot write {}: it is {}; an output file must be a regular file or a new name",
+            path.display(),
+            describe_file_type(&meta.file_type())
+        ),
+    }
+}
+
+/// Creates the output folder `dir` (and its parents) unless it exists; an
+/// existing `dir` must be a directory (a symbolic link to a directory is
+/// followed). Anything else (a regular file, a FIFO, a device, a link to
+/// one, a dangling link) is refused with an error naming it.
+pub fn create_output_dir(dir: &Path) -> Result<()> {
+    match fs::metadata(dir) {
+        Ok(meta) if meta.is_dir() => return Ok(()),
+        Ok(meta) => anyhow::bail!(
+            "cannot use {} as an output folder: it is {}, not a directory",
+            dir.display(),
+            describe_file_type(&meta.file_type())
+        ),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e).with_context(|| format!("cannot use {} as an output folder", dir.display())),
+    }
+    if fs::symlink_metadata(dir).is_ok() {
+        anyhow::bail!(
+            "cannot use {} as an output folder: it is a symbolic link to nothing",
+            dir.display()
+        );
+    }
+    fs::create_dir_all(dir).with_context(|| format!("cannot create output folder {}", dir.display()))
+}
+
 /// Writes `contents` to `path` atomically: into a temporary file in the same
 /// directory, flushed to disk, then renamed over `path`, and the directory
 /// flushed too. A crash leaves either the old file or the new one, never a
@@ -87,6 +136,7 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
 /// a long output never has to be held in memory). When `write` fails,
 /// `path` is left as it was and its error is returned.
 pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+    check_output_file(path)?;
     let (dir, tmp) = temporary_beside(path)?;
     let result = (|| -> Result<()> {
         let mut file = BufWriter::new(fs::File::create(&tmp)?);
@@ -125,6 +175,7 @@ fn temporary_beside(path: &Path) -> Result<(&Path, std::path::PathBuf)> {
 /// Several processes on several hosts may race for one `path`: exactly one
 /// creates it.
 pub fn create_new_atomic(path: &Path, contents: &[u8]) -> Result<bool> {
+    check_output_file(path)?;
     let (dir, tmp) = temporary_beside(path)?;
     let result = (|| -> std::io::Result<bool> {
         let mut file = fs::File::create(&tmp)?;
@@ -163,6 +214,36 @@ pub fn temporary_name(name: &str) -> String {
         std::process::id(),
         COUNTER.fetch_add(1, Ordering::Relaxed)
     )
+}
+
+/// Removes the temporary files (see [`temporary_name`]) that processes of
+/// this host which are no longer running left in `dir` when they were
+/// killed; those of live processes and of other hosts are left alone.
+/// Returns how many it removed.
+pub fn remove_stale_temporaries(dir: &Path) -> usize {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return 0;
+    };
+    let marker = format!(".tmp-{}-", crate::provenance::host_name());
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(at) = name.find(&marker).filter(|_| name.starts_with('.')) else {
+            continue;
+        };
+        let pid: String = name[at + marker.len()..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect();
+        let Ok(pid) = pid.parse::<u32>() else { continue };
+        let gone = pid != std::process::id()
+            && Path::new("/proc/self").exists()
+            && !Path::new(&format!("/proc/{pid}")).exists();
+        if gone && entry.file_type().is_ok_and(|t| t.is_file()) && fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
 }
 
 /// Flushes the directory `dir` to disk, so that a rename into it survives
@@ -209,34 +290,10 @@ pub fn read_versioned_json<T: serde::de::DeserializeOwned>(
     serde_json::from_value(value).with_context(|| format!("{}", path.display()))
 }
 
-/// A `u64` written to JSON as a string (`"18446744073709551615"`), read
-/// back from a string or a number. JSON tools that read numbers as doubles
-/// (jq, JavaScript, Python's `float`) lose digits above 2^53; a string keeps
-/// every seed exact. Use with `#[serde(with = "crate::io::u64_string")]`.
-pub mod u64_string {
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    /// Writes `value` as a decimal string.
-    pub fn serialize<S: Serializer>(value: &u64, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(value)
-    }
-
-    /// Reads a `u64` from a decimal string or a JSON number.
-    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<u64, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum Either {
-            Number(u64),
-            Text(String),
-        }
-        match Either::deserialize(deserializer)? {
-            Either::Number(n) => Ok(n),
-            Either::Text(text) => text
-                .parse()
-                .map_err(|_| serde::de::Error::custom(format!("{text:?} is not a whole number in [0, 2^64)"))),
-        }
-    }
-}
+/// Seeds as decimal strings in JSON (tools that read numbers as doubles
+/// lose digits above 2^53): the search crate's, so that both write them
+/// alike. Use with `#[serde(with = "crate::io::u64_string")]`.
+pub use esp_neuroevolution::rng::u64_string;
 
 #[cfg(test)]
 mod tests {

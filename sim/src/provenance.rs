@@ -15,6 +15,10 @@ pub struct BuildInfo {
     pub git_commit: String,
     /// The libode version `ode-sys` was built against.
     pub libode_version: String,
+    /// How many rows the build's table of defaults had
+    /// ([`crate::psa::defaults`]); absent in files of builds before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub defaults: Option<u64>,
 }
 
 /// The current UTC time as RFC 3339, to the second.

@@ -7,7 +7,7 @@ use anyhow::Result;
 
 use super::replicate::read_overrides;
 use crate::experiment::grid::GridSpec;
-use crate::experiment::rescore::{rescore, rescored_spec};
+use crate::experiment::rescore::{check_out, check_rescoring_acts, rescore, rescored_spec};
 use crate::ode::MAX_THREADS;
 use crate::psa::limits::MAX_TRIALS;
 
@@ -37,6 +37,8 @@ pub fn run(args: RescoreArgs) -> Result<i32> {
     let overlay = read_overrides(&args.config)?;
     let source = GridSpec::load(&args.grid)?;
     let spec = rescored_spec(&source, &overlay, args.robustness_trials.map(|t| t as usize))?;
+    check_out(&args.grid, &args.out)?;
+    check_rescoring_acts(&args.grid, &source, &overlay)?;
     let summary = rescore(&args.grid, &args.out, &spec, args.threads as usize)?;
     say!(
         "rescore {} -> {}: {} finished runs, {} already re-scored, {} re-scored now, {} unfinished left out, in {:.1} s",

@@ -182,8 +182,13 @@ impl Esp {
         let progressed = followed.is_none_or(|best| top_fitness > best + s.stagnation_min_improvement);
         if state.best.as_ref().is_none_or(|(_, f)| top_fitness > *f) {
             state.best = Some((top, top_fitness));
-            state.bursts_since_improvement = 0;
-            state.pending = None;
+            // After an erasure at a burst, only a network better than the
+            // one forgotten is an improvement of the search.
+            if state.erased.is_none_or(|erased| top_fitness > erased) {
+                state.erased = None;
+                state.bursts_since_improvement = 0;
+                state.pending = None;
+            }
         }
         state.phase_best = Some(state.phase_best.map_or(top_fitness, |best| best.max(top_fitness)));
         if progressed {

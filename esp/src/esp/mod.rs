@@ -14,7 +14,7 @@ mod stagnation;
 #[cfg(test)]
 mod tests;
 
-pub use settings::{BurstMode, Credit, EspSettings, Sampling, StagnationRule, TopologyMode};
+pub use settings::{BurstMode, Credit, EraseAt, EspSettings, Relesion, Sampling, StagnationRule, TopologyMode};
 
 /// An ESP run: settings, seed and when to stop early.
 use serde::{Deserialize, Serialize};
@@ -27,12 +27,33 @@ use crate::run::{drive, public_run, Driver};
 use crate::subpop::Subpop;
 use crate::{Control, Evaluator, GenerationRecord, RunError, RunResult, SettingsError, StopAt};
 
-/// An ESP run: settings, seed and when to stop early.
+/// An ESP run: settings, seed and when to stop early. Read from JSON (or
+/// any serde format) it is checked as [`Esp::new`] checks it; the seed is
+/// written as a string, so that JSON tools reading numbers as doubles keep
+/// every digit (a number is read too).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "Unchecked")]
 pub struct Esp {
     settings: EspSettings,
+    #[serde(with = "crate::rng::u64_string")]
     seed: u64,
     stop: StopAt,
+}
+
+/// An [`Esp`] as read, before its settings are checked.
+#[derive(Deserialize)]
+struct Unchecked {
+    settings: EspSettings,
+    #[serde(with = "crate::rng::u64_string")]
+    seed: u64,
+    stop: StopAt,
+}
+
+impl TryFrom<Unchecked> for Esp {
+    type Error = SettingsError;
+    fn try_from(raw: Unchecked) -> Result<Esp, SettingsError> {
+        Ok(Esp::new(raw.settings, raw.seed)?.stop_at(raw.stop))
+    }
 }
 
 impl Esp {

@@ -34,6 +34,13 @@ pub(crate) struct State {
     pub(super) bursts_since_improvement: usize,
     /// Discard-all: the topology change to apply again after each burst.
     pub(super) pending: Option<LesionOutcome>,
+    /// Erasing at every burst ([`EraseAt::Burst`](super::EraseAt)): the
+    /// fitness of the best network forgotten, which a network must beat
+    /// for the burst count towards a lesion test to restart (§3.2: a
+    /// lesion test follows when "maximum fitness still does not
+    /// improve"). Absent in states saved before the setting existed.
+    #[serde(default)]
+    pub(super) erased: Option<f64>,
     /// Burst mutations so far.
     pub(super) bursts: usize,
     /// Networks evaluated so far, lesion tests included.
@@ -53,6 +60,7 @@ impl State {
             phase_best: None,
             bursts_since_improvement: 0,
             pending: None,
+            erased: None,
             bursts: 0,
             evaluations: 0,
         }

@@ -77,6 +77,42 @@ pub enum TopologyMode {
     Off,
 }
 
+/// When [`EspSettings::erase_best`] forgets the search's best network
+/// (Høverstad's Table 6, "Erase").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EraseAt {
+    /// At every burst mutation, once the sub-populations are rebuilt
+    /// around it: Table 6's caption ("best network erased at each burst
+    /// mutation") and §5.3, which describe the experiment that made the
+    /// table.
+    Burst,
+    /// Whenever a sub-population is added or removed: §3.2's wording of
+    /// the option ("discard the best network whenever a sub-population is
+    /// added or removed").
+    TopologyChange,
+}
+
+/// When discard-all burst mutation ([`BurstMode::DiscardAll`]) asks for a
+/// new lesion test of the best network after rebuilding the
+/// sub-populations around it, outside the lesion test that
+/// [`EspSettings::bursts_before_lesion`] triggers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Relesion {
+    /// While a topology change is pending: the last lesion test's change
+    /// has not yet brought a better network (§3.2's example: "erasing all
+    /// 6 sub-populations after stagnation, after which a new lesion test is
+    /// performed on the 5-neuron solution, a 6th sub-population is once
+    /// again added").
+    Pending,
+    /// At every discard-all burst mutation: §3.2's "discard all
+    /// sub-populations at each round of burst mutation", each followed by
+    /// "a new lesion test ... on the" best network, whether or not a
+    /// change is pending.
+    EveryBurst,
+}
+
 /// Every setting of ESP, named in configuration files as `esp.<field>`.
 ///
 /// The default is Gomez's ESP ([`EspSettings::gomez`]); Høverstad's
@@ -156,10 +192,17 @@ pub struct EspSettings {
     /// as a ratio: the lesion test is the only step of ESP that adding a
     /// constant to every fitness can change.
     pub lesion_threshold: f64,
-    /// Forget the search's best network whenever a sub-population is added
-    /// or removed (Høverstad's Table 6). Default false (Gomez's and
-    /// Høverstad's).
+    /// Forget the search's best network, at the moments `erase_at` says
+    /// (Høverstad's Table 6). Default false (Gomez's and Høverstad's).
     pub erase_best: bool,
+    /// When `erase_best` forgets the best network. Default
+    /// topology_change (the reading of files written before the setting
+    /// existed); Høverstad's preset: burst (Table 6's caption).
+    pub erase_at: EraseAt,
+    /// When discard-all burst mutation tests the best network again.
+    /// Default pending (the reading of files written before the setting
+    /// existed, and Høverstad's preset).
+    pub relesion: Relesion,
 }
 
 /// Whether a minimum improvement is the default 0 (left out of a written
@@ -205,17 +248,22 @@ impl EspSettings {
             bursts_before_lesion: 1,
             lesion_threshold: 0.8,
             erase_best: false,
+            erase_at: EraseAt::TopologyChange,
+            relesion: Relesion::Pending,
         }
     }
 
     /// Høverstad's modified ESP (his Table 1): burst mutation discards all
     /// sub-populations ([`BurstMode::DiscardAll`]), two fruitless burst
-    /// mutations bring a lesion test, and the lesion threshold is 0.9.
+    /// mutations bring a lesion test, the lesion threshold is 0.9, and
+    /// erasing the best network (when switched on) happens at every burst
+    /// mutation ([`EraseAt::Burst`], his Table 6's caption).
     pub fn hoverstad() -> EspSettings {
         EspSettings {
             burst: BurstMode::DiscardAll,
             bursts_before_lesion: 2,
             lesion_threshold: 0.9,
+            erase_at: EraseAt::Burst,
             ..EspSettings::gomez()
         }
     }

@@ -3,7 +3,7 @@
 
 use super::generation::{Stats, Step};
 use super::population::State;
-use super::{BurstMode, Esp, TopologyMode};
+use super::{BurstMode, EraseAt, Esp, Relesion, TopologyMode};
 use crate::network::Network;
 use crate::operators::cauchy;
 use crate::purpose;
@@ -57,8 +57,12 @@ impl Esp {
                 state.subpops = (0..best.hidden())
                     .map(|k| self.around(best.neuron(k), &mut rng))
                     .collect();
-                if outcome.is_none() && s.topology == TopologyMode::Lesion && state.pending.is_some() {
-                    // The pending change is decided again by a new lesion test.
+                let relesion = match s.relesion {
+                    Relesion::Pending => state.pending.is_some(),
+                    Relesion::EveryBurst => true,
+                };
+                if outcome.is_none() && s.topology == TopologyMode::Lesion && relesion {
+                    // The change is decided again by a new lesion test.
                     return Advance::Ask(Step::Lesion {
                         variants: lesion_variants(state),
                         before_burst: false,
@@ -84,8 +88,20 @@ impl Esp {
             state.pending = Some(change);
             self.apply_change(state, change, generation, false);
         }
-        if outcome.is_some() && s.erase_best {
-            state.best = None;
+        let forget = s.erase_best
+            && match s.erase_at {
+                EraseAt::Burst => true,
+                EraseAt::TopologyChange => outcome.is_some(),
+            };
+        if forget {
+            let forgotten = state.best.take().map(|(_, fitness)| fitness);
+            if s.erase_at == EraseAt::Burst {
+                // The level a network must beat to count as the search's improvement.
+                state.erased = match (state.erased, forgotten) {
+                    (Some(erased), Some(fitness)) => Some(erased.max(fitness)),
+                    (erased, fitness) => erased.or(fitness),
+                };
+            }
         }
         state.bursts += 1;
         state.bursts_since_improvement += 1;

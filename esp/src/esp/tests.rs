@@ -168,6 +168,29 @@ fn only_children_are_mutated_at_the_configured_rate() {
 }
 
 #[test]
+fn random_sampling_picks_each_network_s_neurons_uniformly_and_independently() {
+    let e = esp(EspSettings::hoverstad());
+    let mut counts = vec![[0usize; 40]; 5];
+    for generation in 1..=25 {
+        let picks = e.sample(generation, 5);
+        assert_eq!(picks.count(), 400);
+        for network in picks.networks() {
+            for (subpop, &neuron) in network.iter().enumerate() {
+                counts[subpop][neuron] += 1;
+            }
+        }
+    }
+    // 25 generations x 400 networks: each neuron expected 250 times.
+    for subpop in &counts {
+        let chi2: f64 = subpop.iter().map(|&c| (c as f64 - 250.0).powi(2) / 250.0).sum();
+        // 39 degrees of freedom: the 99.9th percentile is 72.1.
+        assert!(chi2 < 72.1, "chi-square {chi2}");
+        // Not systematic: some neuron is picked other than 10 times a generation.
+        assert!(subpop.iter().any(|&c| c != 250));
+    }
+}
+
+#[test]
 fn systematic_sampling_evaluates_every_neuron_exactly_ten_times() {
     let e = esp(EspSettings {
         sampling: Sampling::Systematic,
@@ -372,6 +395,7 @@ fn erase_best_forgets_the_best_on_a_topology_change_but_keeps_the_champion() {
         trials_per_neuron: 2,
         stagnation: 3,
         erase_best: true,
+        erase_at: EraseAt::TopologyChange,
         ..EspSettings::hoverstad()
     });
     let mut st = state(&e, 5);
@@ -391,6 +415,171 @@ fn erase_best_forgets_the_best_on_a_topology_change_but_keeps_the_champion() {
         }
     }
     assert!(saw_erase);
+}
+
+/// Records of `generations` generations of `settings` (small populations,
+/// b = 3) on a problem that never improves after its first generation.
+fn records_of(settings: EspSettings, generations: usize) -> Vec<(GenerationRecord, Option<f64>)> {
+    let e = esp(EspSettings {
+        subpop_size: 8,
+        trials_per_neuron: 2,
+        stagnation: 3,
+        ..settings
+    });
+    let mut st = state(&e, 5);
+    let eval = all_neurons_needed();
+    (1..=generations)
+        .map(|g| {
+            let record = e.generation(&eval, &mut st, g).unwrap();
+            (record, st.erased)
+        })
+        .collect()
+}
+
+/// The records of [`records_of`] as text, to compare two runs whole.
+fn debug_records(records: Vec<(GenerationRecord, Option<f64>)>) -> Vec<String> {
+    records.iter().map(|(r, _)| format!("{r:?}")).collect()
+}
+
+#[test]
+fn erase_at_burst_forgets_the_best_at_every_burst_and_lesion_tests_still_follow() {
+    let erase = |at| EspSettings {
+        erase_best: true,
+        erase_at: at,
+        ..EspSettings::hoverstad()
+    };
+    let at_burst = records_of(erase(EraseAt::Burst), 60);
+    let bursts: Vec<&GenerationRecord> = at_burst.iter().map(|(r, _)| r).filter(|r| r.burst).collect();
+    assert!(bursts.len() >= 10, "{} bursts", bursts.len());
+    // Table 6's caption: the best network is erased at each burst mutation.
+    assert!(bursts.iter().all(|r| r.best.is_none()), "forgotten at every burst");
+    assert!(at_burst.iter().filter(|(r, _)| !r.burst).all(|(r, _)| r.best.is_some()));
+    // The forgotten fitness is the bar: no network beats 1, so the
+    // fruitless bursts still bring lesion tests (every second burst).
+    assert!(at_burst.iter().skip(4).all(|(_, erased)| *erased == Some(1.0)));
+    let lesions = bursts.iter().filter(|r| r.lesion.is_some()).count();
+    assert!(
+        lesions * 2 >= bursts.len() - 1,
+        "{lesions} lesion tests in {} bursts",
+        bursts.len()
+    );
+    assert!(at_burst.iter().all(|(r, _)| r.champion == 1.0), "the champion stays");
+    // On a topology change only: a burst without a lesion test keeps the best.
+    let on_change = records_of(erase(EraseAt::TopologyChange), 60);
+    assert!(on_change
+        .iter()
+        .any(|(r, _)| r.burst && r.lesion.is_none() && r.best.is_some()));
+    assert!(on_change.iter().all(|(r, _)| r.lesion.is_none() || r.best.is_none()));
+    assert!(on_change.iter().all(|(_, erased)| erased.is_none()));
+    // erase_at alone changes nothing while erase_best is off.
+    let off = |at| EspSettings {
+        erase_at: at,
+        ..EspSettings::hoverstad()
+    };
+    assert_eq!(
+        debug_records(records_of(off(EraseAt::Burst), 40)),
+        debug_records(records_of(off(EraseAt::TopologyChange), 40))
+    );
+}
+
+#[test]
+fn the_lesion_trigger_counts_fruitless_bursts_and_the_threshold_is_the_share_kept() {
+    // The trigger: the first lesion test comes at the n-th fruitless burst.
+    for trigger in [1, 2, 3] {
+        let records = records_of(
+            EspSettings {
+                bursts_before_lesion: trigger,
+                burst: BurstMode::Gomez,
+                ..EspSettings::hoverstad()
+            },
+            80,
+        );
+        let bursts: Vec<&GenerationRecord> = records.iter().map(|(r, _)| r).filter(|r| r.burst).collect();
+        let first = bursts.iter().position(|r| r.lesion.is_some()).unwrap();
+        assert_eq!(
+            first, trigger,
+            "trigger {trigger}: a lesion test at the burst after {trigger} fruitless ones"
+        );
+    }
+    // The threshold: a neuron whose loss keeps exactly 85 % is redundant
+    // at 0.8, not at 0.9.
+    let net = Network::from_neurons(2, 1, &[vec![8.5, 0.0, 0.0], vec![1.5, 0.0, 0.0]]).unwrap();
+    for (threshold, outcome) in [(0.8, LesionOutcome::Remove { neuron: 1 }), (0.9, LesionOutcome::Add)] {
+        let e = esp(EspSettings {
+            lesion_threshold: threshold,
+            ..EspSettings::hoverstad()
+        });
+        let mut st = state(&e, 2);
+        st.best = Some((net.clone(), 10.0));
+        assert_eq!(e.lesion_test(&redundancy_evaluator(), &mut st, 1).unwrap(), outcome);
+    }
+}
+
+#[test]
+fn the_burst_scale_is_the_cauchy_scale_of_the_burst_noise() {
+    for scale in [0.1, 1.0] {
+        let e = esp(EspSettings {
+            topology: TopologyMode::Off,
+            burst_scale: scale,
+            ..EspSettings::hoverstad()
+        });
+        let mut st = state(&e, 2);
+        let best = Network::from_neurons(2, 1, &[vec![1.0, 2.0, 3.0], vec![-1.0, 0.0, 1.0]]).unwrap();
+        st.best = Some((best.clone(), 1.0));
+        e.stagnate(&all_neurons_needed(), &mut st, 1).unwrap();
+        let mut deltas: Vec<f64> = (0..2)
+            .flat_map(|k| {
+                let reference = best.neuron(k).to_vec();
+                st.subpops[k]
+                    .neurons()
+                    .flat_map(move |n| {
+                        n.iter()
+                            .zip(reference.clone())
+                            .map(|(a, b)| (a - b).abs())
+                            .collect::<Vec<_>>()
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        deltas.sort_by(f64::total_cmp);
+        // The median of |Cauchy(scale)| is the scale itself.
+        let median = deltas[deltas.len() / 2];
+        assert!(
+            (0.7 * scale..1.4 * scale).contains(&median),
+            "scale {scale}: median {median}"
+        );
+    }
+}
+
+#[test]
+fn relesion_every_burst_tests_the_best_at_each_discard_all_burst() {
+    let relesion = |r| EspSettings {
+        relesion: r,
+        ..EspSettings::hoverstad()
+    };
+    // Pending: the first bursts (no change yet pending, fewer than two
+    // fruitless bursts) rebuild the sub-populations without a lesion test.
+    let pending = records_of(relesion(Relesion::Pending), 60);
+    let first_burst = pending.iter().map(|(r, _)| r).find(|r| r.burst).unwrap();
+    assert_eq!(first_burst.lesion, None);
+    // Every burst: each discard-all burst is followed by a lesion test,
+    // whose change is applied.
+    let every = records_of(relesion(Relesion::EveryBurst), 60);
+    let bursts: Vec<&GenerationRecord> = every.iter().map(|(r, _)| r).filter(|r| r.burst).collect();
+    assert!(bursts.len() >= 10);
+    assert!(bursts.iter().all(|r| r.lesion.is_some()), "{bursts:?}");
+    assert_eq!(bursts[0].lesion, Some(LesionOutcome::Add));
+    assert_eq!(bursts[0].subpops, 6, "the first burst's test adds a sub-population");
+    // Gomez's burst keeps its own timing: the setting is discard-all's.
+    let gomez = |r| EspSettings {
+        burst: BurstMode::Gomez,
+        relesion: r,
+        ..EspSettings::hoverstad()
+    };
+    assert_eq!(
+        debug_records(records_of(gomez(Relesion::EveryBurst), 40)),
+        debug_records(records_of(gomez(Relesion::Pending), 40))
+    );
 }
 
 #[test]
@@ -463,7 +652,7 @@ fn a_run_stops_where_the_goal_the_budget_or_the_callback_says_and_returns_its_re
 }
 
 #[test]
-fn gomez_and_hoverstad_differ_in_burst_mode_lesion_timing_and_threshold_only() {
+fn gomez_and_hoverstad_differ_in_burst_mode_lesion_timing_threshold_and_erasing_only() {
     let (g, h) = (EspSettings::gomez(), EspSettings::hoverstad());
     assert_eq!(EspSettings::default(), g);
     assert_eq!(
@@ -474,11 +663,14 @@ fn gomez_and_hoverstad_differ_in_burst_mode_lesion_timing_and_threshold_only() {
         (h.burst, h.bursts_before_lesion, h.lesion_threshold),
         (BurstMode::DiscardAll, 2, 0.9)
     );
+    assert_eq!((g.erase_at, h.erase_at), (EraseAt::TopologyChange, EraseAt::Burst));
+    assert_eq!((g.relesion, h.relesion), (Relesion::Pending, Relesion::Pending));
     assert_eq!(
         EspSettings {
             burst: h.burst,
             bursts_before_lesion: h.bursts_before_lesion,
             lesion_threshold: h.lesion_threshold,
+            erase_at: h.erase_at,
             ..g
         },
         h

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{ensure, Context, Result};
+use anyhow::{ensure, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -101,7 +101,7 @@ pub fn write_curve_figure(figure: &CurveFigure, dir: &Path, stem: &str) -> Resul
     figure.validate()?;
     ensure!(!stem.is_empty(), "the file stem must not be empty");
     ensure_font()?;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    crate::io::create_output_dir(dir)?;
     let svg_path = dir.join(format!("{stem}.svg"));
     let png_path = dir.join(format!("{stem}.png"));
 

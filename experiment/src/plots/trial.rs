@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-use anyhow::{ensure, Context};
+use anyhow::ensure;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -45,7 +45,7 @@ pub fn write_trial_pictures(picture: &TrialPicture, dir: &Path, stem: &str) -> a
     picture.validate()?;
     ensure!(!stem.is_empty(), "the file stem must not be empty");
     ensure_font()?;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    crate::io::create_output_dir(dir)?;
 
     let svg_path = dir.join(format!("{stem}.svg"));
     let png_path = dir.join(format!("{stem}.png"));

@@ -75,15 +75,18 @@ pub(super) fn distance_md(md: &mut String, distance: &Distance) {
     );
     let _ = writeln!(
         md,
-        "D = {:.1}: the sum of ((here - paper) / se)^2 over Table 1's task means, Table 2's means and the two burst totals, \
-         se being the paper's sd / sqrt(30) for a mean and sqrt(total) for a total (see docs/model.md).\n",
-        distance.total
+        "D = {:.1}: the sum of ((here - paper) / se)^2 over Table 1's and Table 2's means and the two burst totals \
+         (the means: {:.1}), the standard deviations of the same cells (the spreads: {:.1}) and max credit's bursts \
+         over the baseline's (the burst ratio: {:.1}); se is the paper's sd / sqrt(30) for a mean, sd / sqrt(58) for \
+         an sd, sqrt(total) for a total (see docs/model.md).\n",
+        distance.total, distance.means, distance.spreads, distance.burst_ratio
     );
-    md.push_str("| term | here | paper | se | z |\n|---|---|---|---|---|\n");
+    md.push_str("| part | term | here | paper | se | z |\n|---|---|---|---|---|---|\n");
     for t in &distance.terms {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {:+.1} |",
+            "| {} | {} | {} | {} | {} | {:+.1} |",
+            t.part.name(),
             t.label,
             num(t.here),
             num(t.paper),
@@ -155,11 +158,8 @@ fn grid_section(md: &mut String, report: &Report) {
     for (k, v) in rows {
         let _ = writeln!(md, "| {k} | {v} |");
     }
-    if let Some(config) = g.configs.first() {
-        if let (Ok(run), Ok(scoring)) = (g.run_config(*config), g.scoring_config(*config)) {
-            let readings = run.problem.describe_readings(&scoring.problem);
-            let _ = writeln!(md, "| readings | {} |", readings.join("; "));
-        }
+    if !report.readings.is_empty() {
+        let _ = writeln!(md, "| readings | {} |", report.readings.join("; "));
     }
     if let Some(rescoring) = &g.rescoring {
         let settings: Vec<String> = rescoring

@@ -195,14 +195,15 @@ impl SweepReport {
         md.push_str(
             "Table 1: baseline champions (%), paper 42.4 / 44.0 / 11.9. Bursts per run: baseline and max credit, \
              paper 27.2 and 20.8. Noise and random-init ratios: the baseline champions' robust mean over their clean mean \
-             (paper 0.11 and 0.22). D: the distance to the paper (smaller is closer; docs/model.md).\n\n",
+             (paper 0.11 and 0.22). D: the distance to the paper (smaller is closer; docs/model.md), then its parts: \
+             the means (Table 1 and 2 means, burst totals), the spreads (their sds) and the burst ratio.\n\n",
         );
-        md.push_str("| variant | runs | T1 task 1 | T1 task 2 | T1 task 3 | bursts base | bursts max | noise ratio | random-init ratio | D |\n");
-        md.push_str("|---|---|---|---|---|---|---|---|---|---|\n");
+        md.push_str("| variant | runs | T1 task 1 | T1 task 2 | T1 task 3 | bursts base | bursts max | noise ratio | random-init ratio | D | means | spreads | burst ratio |\n");
+        md.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for v in &self.variants {
             let _ = writeln!(
                 md,
-                "| {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {:.1} |",
+                "| {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} |",
                 v.name,
                 v.runs.0,
                 v.runs.1,
@@ -213,7 +214,10 @@ impl SweepReport {
                 num(v.bursts_per_run[1]),
                 ratio(v.noise_ratio),
                 ratio(v.random_init_ratio),
-                v.distance.total
+                v.distance.total,
+                v.distance.means,
+                v.distance.spreads,
+                v.distance.burst_ratio
             );
         }
         if let Some(best) = self
@@ -359,6 +363,9 @@ mod tests {
                 .collect(),
             distance: Distance {
                 total: 0.0,
+                means: 0.0,
+                spreads: 0.0,
+                burst_ratio: 0.0,
                 terms: Vec::new(),
                 missing: Vec::new(),
             },

@@ -111,6 +111,10 @@ pub struct Report {
     pub reduced: Vec<String>,
     /// The builds that made the counted runs.
     pub builds: Vec<BuildCount>,
+    /// The readings of the inputs and the fitness the runs flew, from the
+    /// first counted run's own configuration (a grid of an earlier build
+    /// flew its build's defaults); empty without a counted run.
+    pub readings: Vec<String>,
     /// Wall-clock seconds of the counted runs, added up.
     pub compute_seconds: f64,
     /// Runs of the grid.
@@ -165,6 +169,26 @@ const CHAMPION_TABLES: [(&str, &str, &[GridConfig]); 6] = [
     ),
 ];
 
+/// The readings of the first counted run of `results`, from its own files
+/// ([`crate::grid::run_folder_config`]), under the grid's rescoring.
+fn readings(results: &GridResults) -> Vec<String> {
+    let Some(run) = results.runs.first() else {
+        return Vec::new();
+    };
+    let folder = crate::grid::run_dir(&results.dir, &run.key);
+    let Ok(config) = crate::grid::run_folder_config(&folder) else {
+        return Vec::new();
+    };
+    let scoring = match &results.spec.rescoring {
+        Some(text) => match config.with_overrides(text) {
+            Ok(scoring) => scoring,
+            Err(_) => return Vec::new(),
+        },
+        None => config.clone(),
+    };
+    config.problem.describe_readings(&scoring.problem)
+}
+
 impl Report {
     /// The report of `results` (figures not yet drawn).
     pub fn from_results(results: &GridResults) -> Report {
@@ -184,6 +208,7 @@ impl Report {
             grid: spec.clone(),
             reduced: reductions(spec),
             builds: builds(results),
+            readings: readings(results),
             compute_seconds: results.runs.iter().map(|r| r.summary.seconds).sum(),
             runs_expected: spec.runs().len(),
             runs_counted: results.runs.len(),

@@ -400,3 +400,52 @@ fn p_values_print_like_the_paper() {
     let printed: Vec<String> = [0.8, 0.35, 1.0, 0.1, 9.5e-5, 0.014, 0.0, f64::NAN].map(fmt_p).to_vec();
     assert_eq!(printed, ["0.8", "0.35", "1", "0.1", "9.5e-5", "1.4e-2", "0", "–"]);
 }
+
+#[test]
+fn distance_terms_follow_their_definitions() {
+    let (dir, _) = grid();
+    let results = GridResults::load(dir.path()).unwrap();
+    let d = Distance::of(&results);
+    let term = |label: &str| d.terms.iter().find(|t| t.label == label).unwrap();
+    // Table 1 task 1: baseline champions 10, 20, 30: mean 20, sd 10.
+    let mean = term("Table 1 task 1");
+    assert_eq!((mean.part, mean.here, mean.paper), (Part::Mean, 20.0, 42.4));
+    assert!(close(mean.se, 12.8 / 30f64.sqrt()));
+    let sd = term("Table 1 task 1 sd");
+    assert_eq!((sd.part, sd.here, sd.paper), (Part::Spread, 10.0, 12.8));
+    // The se of a sample sd over the paper's 30 runs: sd / sqrt(2 x 29).
+    assert!(close(sd.se, 12.8 / 58f64.sqrt()));
+    assert!(close(sd.z, (10.0 - 12.8) / (12.8 / 58f64.sqrt())));
+    // No task 3 here: the burst totals and their ratio are missing, not counted.
+    assert!(d.missing.iter().any(|m| m == "bursts max-credit / baseline"));
+    assert!(d.missing.iter().any(|m| m.starts_with("bursts baseline")));
+    let parts: f64 = Part::ALL
+        .iter()
+        .map(|&p| d.terms.iter().filter(|t| t.part == p).map(|t| t.z * t.z).sum::<f64>())
+        .sum();
+    assert!(close(parts, d.total) && close(d.means + d.spreads + d.burst_ratio, d.total));
+    assert!(
+        d.burst_ratio == 0.0 && d.burst_ratio.is_sign_positive(),
+        "a missing part prints as 0, not -0"
+    );
+}
+
+#[test]
+fn the_burst_ratio_is_max_credit_over_baseline_in_the_se_of_two_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = GridSpec {
+        tasks: Task::ALL.to_vec(),
+        ..spec()
+    };
+    spec.save(dir.path()).unwrap();
+    for key in spec.runs() {
+        write_run(dir.path(), &spec, &key);
+    }
+    let d = Distance::of(&GridResults::load(dir.path()).unwrap());
+    let ratio = d.terms.iter().find(|t| t.part == Part::BurstRatio).unwrap();
+    // Max credit never bursts here; the baseline bursts s times in seed s.
+    let paper = 1868.0 / 2448.0;
+    assert_eq!((ratio.here, ratio.paper), (0.0, paper));
+    assert!(close(ratio.se, paper * (1.0 / 2448.0 + 1.0 / 1868.0f64).sqrt()));
+    assert!(close(d.burst_ratio, ratio.z * ratio.z));
+}

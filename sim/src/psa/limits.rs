@@ -48,7 +48,7 @@ const SPEED_WHY: &str = "the tasks start at up to 0.4 m/s, the fastest flight mo
 /// Angular velocities (rad/s).
 const SPIN: [f64; 2] = [-100.0, 100.0];
 const SPIN_WHY: &str =
-    "the start spins fitted to the paper are 1 (task 1) and 0.75 rad/s (task 2); 100 rad/s is 16 turns a second";
+    "the start spins fitted to the paper are about 1 rad/s; 100 rad/s is 16 turns a second";
 /// Input scalings (input units per SI unit) and the bias input.
 const SCALE: [f64; 2] = [-1000.0, 1000.0];
 const SCALE_WHY: &str =

@@ -5,6 +5,7 @@
 pub mod batch;
 pub mod body;
 pub mod cuda;
+pub mod defaults;
 pub mod fitness;
 pub mod limits;
 pub mod network_file;

@@ -25,8 +25,41 @@ use super::sensors::SensorSettings;
 use super::task::Task;
 use super::trial::PsaSettings;
 use crate::network::Network;
-use crate::numeric::Exponential;
 use crate::provenance::BuildInfo;
+
+/// The dotted path (`.sensors.heading_wrap`) of the first leaf of the JSON
+/// object `doc` that alone makes it fail to read, laid over the defaults
+/// (`parses` says whether a document reads): serde's own errors do not say
+/// where an unknown variant or a wrong type was.
+pub fn bad_key(doc: &serde_json::Value, parses: &dyn Fn(&serde_json::Value) -> bool) -> Option<String> {
+    fn leaves(value: &serde_json::Value, path: &mut Vec<String>, out: &mut Vec<(Vec<String>, serde_json::Value)>) {
+        match value.as_object() {
+            Some(object) if !object.is_empty() => {
+                for (key, child) in object {
+                    path.push(key.clone());
+                    leaves(child, path, out);
+                    path.pop();
+                }
+            }
+            _ => out.push((path.clone(), value.clone())),
+        }
+    }
+    let mut all = Vec::new();
+    leaves(doc, &mut Vec::new(), &mut all);
+    all.into_iter().find_map(|(path, leaf)| {
+        let mut alone = serde_json::Value::Object(serde_json::Map::new());
+        let mut at = &mut alone;
+        for part in &path {
+            at = at
+                .as_object_mut()
+                .expect("built of objects")
+                .entry(part.clone())
+                .or_insert_with(|| serde_json::Value::Object(serde_json::Map::new()));
+        }
+        *at = leaf;
+        (!parses(&alone)).then(|| format!(".{}", path.join(".")))
+    })
+}
 
 /// The `format` field of every network file.
 pub const FORMAT: &str = "psa-esp-network";
@@ -110,6 +143,8 @@ impl NetworkFile {
         provenance.insert("tool_version".into(), build.tool_version.clone().into());
         provenance.insert("git_commit".into(), build.git_commit.clone().into());
         provenance.insert("libode_version".into(), build.libode_version.clone().into());
+        // Places the file in the table of defaults (see `psa::defaults`).
+        provenance.insert("defaults".into(), super::defaults::rows().into());
         provenance.extend(extra);
         NetworkFile {
             format: FORMAT.into(),
@@ -188,23 +223,22 @@ impl NetworkFile {
             None => return Err(fail("no numeric \"version\" field".into())),
         }
         let mut value = value;
-        if let Some(problem) = value.get_mut("problem").and_then(|p| p.as_object_mut()) {
-            // Files from before the setting existed were evolved with the
-            // accurate exponential (a problem without the key would get
-            // today's default).
-            problem
-                .entry("exponential")
-                .or_insert_with(|| serde_json::json!(Exponential::Accurate));
-            // Likewise, files from before the readings of the fitness were
-            // settings were scored on the fitness they were evolved on,
-            // read from the true state.
-            if let Some(fitness) = problem.get_mut("fitness").and_then(|f| f.as_object_mut()) {
-                fitness
-                    .entry("scoring")
-                    .or_insert_with(|| serde_json::json!(crate::psa::Scoring::Evolution));
-                fitness
-                    .entry("state")
-                    .or_insert_with(|| serde_json::json!(crate::psa::FitnessState::True));
+        // A file that lacks a setting (written before it existed) gets the
+        // value the build that wrote it used (`psa::defaults`).
+        let placement = super::defaults::Placement::of_json(value.get("provenance").and_then(|p| p.as_object()));
+        if let Some(problem) = value.get_mut("problem").filter(|p| p.is_object()) {
+            super::defaults::fill(problem, "problem.", &placement).map_err(|e| fail(format!("problem: {e}")))?;
+        }
+        // The input scaling is the problem's sensors, and lacks what they lack.
+        if let Some(scaling) = value.get_mut("input_scaling").filter(|p| p.is_object()) {
+            super::defaults::fill(scaling, "problem.sensors.", &placement)
+                .map_err(|e| fail(format!("input_scaling: {e}")))?;
+        }
+        if let Some(problem) = value.get("problem") {
+            if let Err(e) = serde_json::from_value::<PsaSettings>(problem.clone()) {
+                let key =
+                    bad_key(problem, &|v| serde_json::from_value::<PsaSettings>(v.clone()).is_ok()).unwrap_or_default();
+                return Err(fail(format!("problem{key}: {e}")));
             }
         }
         let file: NetworkFile = serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;

@@ -102,8 +102,9 @@ pub struct TaskSettings {
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
     /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
-    /// turning when the trial starts. `[fitted]` 0.75: the paper's Table 1
-    /// and 2 levels for task 2 and its burst totals (docs/model.md, sweep S18)
+    /// turning when the trial starts. `[fitted]` 1.0: the paper's Table 1
+    /// and 2 levels for task 2, their spreads and its burst totals
+    /// (docs/model.md, sweeps S18 and S24)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
@@ -126,7 +127,7 @@ impl Default for TaskSettings {
         TaskSettings {
             task1_spin: 1.0,
             task2_target_heading: FRAC_PI_2,
-            task2_spin: 0.75,
+            task2_spin: 1.0,
             task2_velocity: [0.0, 0.0],
             task3_speed: 0.4,
             task3_distance: 0.40,

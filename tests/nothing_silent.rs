@@ -1,0 +1,786 @@
+//! Nothing silent (issue 53): every setting a command takes either acts
+//! or is refused, old results stay readable, and no output path can
+//! clobber the system. One test (or a few) per defect of the issue, each
+//! named after what it holds.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use psa_esp::experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
+use psa_esp::experiment::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_NAME};
+use psa_esp::network::Network;
+use psa_esp::physics::{BackendKind, StartQuaternion};
+use psa_esp::psa::defaults::{value_at, Placement, BUILDS, CHANGES};
+use psa_esp::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};
+
+use common::psa_esp;
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn ok(o: &Output) -> String {
+    assert!(o.status.success(), "exit {:?}: {}", o.status.code(), stderr(o));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Asserts exit code 2 and a message holding every one of `needles`.
+fn refused(o: &Output, needles: &[&str]) -> String {
+    let text = stderr(o);
+    assert_eq!(o.status.code(), Some(2), "expected exit 2: {text}");
+    for needle in needles {
+        assert!(text.contains(needle), "the message lacks {needle:?}: {text}");
+    }
+    assert!(!text.contains("panicked"), "{text}");
+    text
+}
+
+/// Runs the binary with `args`, killed after `limit` (then `None`).
+fn run_within(args: &[&str], limit: Duration) -> Option<Output> {
+    let mut child = Command::new(common::binary())
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Some(child.wait_with_output().unwrap())
+}
+
+fn make_fifo(path: &Path) {
+    assert!(Command::new("mkfifo").arg(path).status().unwrap().success());
+}
+
+/// The full hash of the parent of `commit` (a prefix), from the history
+/// the table of defaults places builds in.
+fn parent_of(commit: &str) -> String {
+    let line = BUILDS
+        .lines()
+        .find(|l| l.starts_with(commit))
+        .expect("a commit of the history");
+    line.split(' ').nth(1).expect("a parent").to_string()
+}
+
+/// A process id that no process has now: a child that has ended.
+fn dead_pid() -> u32 {
+    let mut child = Command::new("true").spawn().unwrap();
+    let pid = child.id();
+    child.wait().unwrap();
+    pid
+}
+
+/// A finished tiny grid (baseline, task 1, one seed, 3 generations), made
+/// once; each test copies it.
+fn finished_grid() -> &'static Path {
+    static GRID: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    let (_, path) = GRID.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("grid");
+        ok(&psa_esp(&tiny_args(&out)));
+        (dir, out)
+    });
+    path
+}
+
+fn tiny_args(out: &Path) -> Vec<&str> {
+    let out = Box::leak(out.display().to_string().into_boxed_str());
+    vec![
+        "replicate",
+        "--preset",
+        "quick",
+        "--configs",
+        "baseline",
+        "--tasks",
+        "1",
+        "--seeds",
+        "1",
+        "--generations",
+        "3",
+        "--robustness-trials",
+        "3",
+        "--threads",
+        "1",
+        "--quiet",
+        "--out",
+        out,
+    ]
+}
+
+/// A copy of the finished tiny grid in `dir`.
+fn copy_of_grid(dir: &Path) -> PathBuf {
+    let copy = dir.join("grid");
+    let status = Command::new("cp")
+        .arg("-a")
+        .arg(finished_grid())
+        .arg(&copy)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    copy
+}
+
+fn run_folder(grid: &Path) -> PathBuf {
+    run_dir(
+        grid,
+        &RunKey {
+            config: "baseline".parse().unwrap(),
+            task: Task::StopRotation,
+            seed: 1,
+        },
+    )
+}
+
+fn names_in(dir: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut names: Vec<String> = entries
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+// 1. Output paths.
+
+#[test]
+fn an_output_path_that_is_a_link_a_fifo_or_a_device_is_refused_and_left_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("precious.txt");
+    std::fs::write(&target, "precious\n").unwrap();
+    let link = dir.path().join("link.csv");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let fifo = dir.path().join("fifo.csv");
+    make_fifo(&fifo);
+    let simulate = |out: &Path| {
+        psa_esp(&[
+            "simulate",
+            "--thrust",
+            "1,0,0,0",
+            "--steps",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    refused(
+        &simulate(&link),
+        &["link.csv", "a symbolic link", "regular file or a new name"],
+    );
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "precious\n");
+    refused(&simulate(&fifo), &["fifo.csv", "a FIFO"]);
+    assert!(std::os::unix::fs::FileTypeExt::is_fifo(
+        &std::fs::symlink_metadata(&fifo).unwrap().file_type()
+    ));
+    // A regular file is replaced whole, a new name created; nothing else is left.
+    ok(&simulate(&target));
+    ok(&simulate(&dir.path().join("new.csv")));
+    assert_eq!(
+        names_in(dir.path()),
+        ["fifo.csv", "link.csv", "new.csv", "precious.txt"]
+    );
+    // Output folders: a file (or a link to one) is not a folder.
+    let out = target.display().to_string();
+    refused(
+        &psa_esp(&["evolve", "--task", "1", "--generations", "1", "--out", &out]),
+        &["precious.txt"],
+    );
+    let grid_link = dir.path().join("grid-link");
+    std::os::unix::fs::symlink(&target, &grid_link).unwrap();
+    refused(&psa_esp(&tiny_args(&grid_link)), &["grid-link", "not a directory"]);
+}
+
+// 2. A file that lacks a setting gets the value of the build that wrote it.
+
+fn network_json(problem: &PsaSettings) -> serde_json::Value {
+    let network = Network::from_genes(7, 4, vec![0.25; 2 * 11]).unwrap();
+    let file = NetworkFile::new(
+        &network,
+        Task::StopRotation,
+        problem,
+        &psa_esp::experiment::build_info(),
+        serde_json::Map::new(),
+    );
+    serde_json::to_value(&file).unwrap()
+}
+
+/// `json` as a file of the build `commit` that knew none of the table's
+/// keys: each taken out of its problem.
+fn as_file_of(json: &mut serde_json::Value, commit: &str) {
+    let provenance = json["provenance"].as_object_mut().unwrap();
+    provenance.remove("defaults");
+    provenance.insert("git_commit".into(), commit.into());
+    for row in CHANGES {
+        // The input scaling is the problem's sensors, as old as they are.
+        if let Some(key) = row.key.strip_prefix("problem.sensors.") {
+            json["input_scaling"].as_object_mut().unwrap().remove(key);
+        }
+        if let Some(path) = row.key.strip_prefix("problem.") {
+            let mut parts: Vec<&str> = path.split('.').collect();
+            let last = parts.pop().unwrap();
+            let mut at = &mut json["problem"];
+            for part in parts {
+                at = &mut at[part];
+            }
+            if let Some(object) = at.as_object_mut() {
+                object.remove(last);
+            }
+        }
+    }
+}
+
+fn load_json(dir: &Path, json: &serde_json::Value) -> Result<PsaSettings, String> {
+    let path = dir.join("net.json");
+    std::fs::write(&path, json.to_string()).unwrap();
+    NetworkFile::load(&path)
+        .map(|(file, _)| file.problem.unwrap())
+        .map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_network_file_from_before_a_setting_loads_with_the_value_its_build_used() {
+    let dir = tempfile::tempdir().unwrap();
+    // Written before the readings of the fitness were settings (d8e86a8).
+    let mut old = network_json(&PsaSettings::default());
+    as_file_of(&mut old, &parent_of("d8e86a8"));
+    let problem = load_json(dir.path(), &old).unwrap();
+    assert_eq!(problem.sensors.heading_wrap, HeadingWrap::Symmetric);
+    assert_eq!(problem.fitness.scoring, Scoring::Evolution);
+    assert_eq!(problem.fitness.state, FitnessState::True);
+    assert_eq!(problem.physics.start_quaternion, StartQuaternion::Raw);
+    assert_eq!(problem.tasks.task1_spin, 2.0);
+    // A dirty build of the same commit likewise.
+    let mut dirty = old.clone();
+    dirty["provenance"]["git_commit"] = format!("{}-dirty", parent_of("d8e86a8")).into();
+    assert_eq!(load_json(dir.path(), &dirty).unwrap(), problem);
+    // A build that cannot be placed is refused, naming the key.
+    let mut unknown = old.clone();
+    unknown["provenance"]["git_commit"] = "0123456789abcdef0123456789abcdef01234567".into();
+    let err = load_json(dir.path(), &unknown).unwrap_err();
+    assert!(err.contains("problem.") && err.contains("0123456789abcdef"), "{err}");
+    // Today's files name every setting and load as written.
+    let new = network_json(&PsaSettings::default());
+    assert_eq!(load_json(dir.path(), &new).unwrap(), PsaSettings::default());
+}
+
+/// The earlier models of `configs/` and the commit whose builds had them
+/// as defaults: the parent of the commit that changed them.
+const MODELS: [(&str, &str); 4] = [
+    ("configs/previous-defaults.toml", "95ee59b"),
+    ("configs/fitted-incremental.toml", "d497677"),
+    ("configs/scored-on-original.toml", "a1ccaad"),
+    ("configs/symmetric-heading.toml", "a70d696"),
+];
+
+#[test]
+fn the_table_of_defaults_gives_each_earlier_model_of_configs_its_values() {
+    for (config, changed) in MODELS {
+        let text = std::fs::read_to_string(repo(config)).unwrap();
+        let table: toml::Table = toml::from_str(&text).unwrap();
+        let placement = Placement::of(None, Some(&parent_of(changed)));
+        let mut checked = 0;
+        for row in CHANGES {
+            let mut at = Some(&table);
+            let mut parts: Vec<&str> = row.key.split('.').collect();
+            let last = parts.pop().unwrap();
+            for part in parts {
+                at = at.and_then(|t| t.get(part)).and_then(|v| v.as_table());
+            }
+            let Some(value) = at.and_then(|t| t.get(last)) else {
+                continue;
+            };
+            let value: serde_json::Value = serde_json::to_value(value).unwrap();
+            let table_value = value_at(row.key, &placement).unwrap().unwrap();
+            let same = match (value.as_f64(), table_value.as_f64()) {
+                (Some(a), Some(b)) => a == b,
+                _ => value == table_value,
+            };
+            assert!(
+                same,
+                "{config}: {} = {value} there, {table_value} in the table",
+                row.key
+            );
+            checked += 1;
+        }
+        assert!(checked >= 4, "{config}: only {checked} keys of the table checked");
+    }
+}
+
+#[test]
+fn a_champion_of_each_earlier_model_replays_to_its_recorded_fitness_bit_for_bit_as_an_old_file() {
+    let dir = tempfile::tempdir().unwrap();
+    for (i, (config, changed)) in MODELS.iter().enumerate() {
+        let out = dir.path().join(format!("run{i}"));
+        ok(&psa_esp(&[
+            "evolve",
+            "--task",
+            "1",
+            "--generations",
+            "2",
+            "--backend",
+            "native",
+            "--config",
+            repo(config).to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]));
+        let run: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        let recorded = run["champion_fitness"].as_f64().unwrap();
+        // The champion as the build of its model would have written it:
+        // none of the settings that build did not have yet.
+        let mut old: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("champion.json")).unwrap()).unwrap();
+        as_file_of(&mut old, &parent_of(changed));
+        let champion = dir.path().join(format!("old{i}.json"));
+        std::fs::write(&champion, old.to_string()).unwrap();
+        let replay = ok(&psa_esp(&[
+            "replay",
+            champion.to_str().unwrap(),
+            "--backend",
+            "native",
+            "--json",
+            "--out",
+            dir.path().join(format!("replay{i}")).to_str().unwrap(),
+        ]));
+        let json: serde_json::Value = serde_json::from_str(&replay).unwrap();
+        let replayed = json["fitness_percent_mean"].as_f64().unwrap();
+        assert_eq!(
+            replayed.to_bits(),
+            recorded.to_bits(),
+            "{config}: {replayed} against {recorded}"
+        );
+    }
+}
+
+// 3. Settings that do nothing act or are refused.
+
+fn grid(configs: &[&str], tasks: &[Task]) -> GridSpec {
+    GridSpec {
+        configs: configs.iter().map(|c| c.parse().unwrap()).collect(),
+        tasks: tasks.to_vec(),
+        seeds: 1,
+        generations: 3,
+        robustness_trials: 3,
+        ..GridSpec::from_preset(GridPreset::Quick)
+    }
+}
+
+fn sweep_of(grid: GridSpec, vary: &[&str]) -> anyhow::Result<SweepSpec> {
+    let vary = vary.iter().map(|v| parse_vary(v)).collect::<anyhow::Result<Vec<_>>>()?;
+    SweepSpec::new(grid, vary, SweepMode::Combinations)
+}
+
+#[test]
+fn a_varied_backend_or_generation_count_is_the_variant_grids_own() {
+    let spec = sweep_of(
+        grid(&["baseline"], &[Task::StopRotation]),
+        &["problem.backend=native,rapier"],
+    )
+    .unwrap();
+    let backends: Vec<BackendKind> = spec
+        .variants()
+        .iter()
+        .map(|v| spec.variant_grid(v).unwrap().backend)
+        .collect();
+    assert_eq!(backends, [BackendKind::Native, BackendKind::Rapier]);
+    let spec = sweep_of(grid(&["baseline"], &[Task::StopRotation]), &["esp.generations=3,4"]).unwrap();
+    let generations: Vec<usize> = spec
+        .variants()
+        .iter()
+        .map(|v| spec.variant_grid(v).unwrap().generations)
+        .collect();
+    assert_eq!(generations, [3, 4]);
+    // In a grid's own settings they are refused: the grid sets them.
+    let mut own = grid(&["baseline"], &[Task::StopRotation]);
+    own.overrides = Some("[problem]\nbackend = \"ode\"\n".into());
+    let err = format!("{:#}", own.check_new().unwrap_err());
+    assert!(err.contains("problem.backend") && err.contains("--backend"), "{err}");
+}
+
+#[test]
+fn a_varied_setting_that_changes_no_run_is_refused_naming_it() {
+    // The input-noise configuration sets the input noise itself.
+    let err = sweep_of(
+        grid(&["input-noise"], &[Task::StopRotation]),
+        &["problem.noise.input_sd=0.0,0.1"],
+    )
+    .unwrap_err();
+    let err = format!("{err:#}");
+    assert!(
+        err.contains("problem.noise.input_sd") && err.contains("changes nothing"),
+        "{err}"
+    );
+    // 1 and 1.0 are one value.
+    let err = format!("{:#}", parse_vary("problem.tasks.task1_spin=1,1.0").unwrap_err());
+    assert!(err.contains("same value"), "{err}");
+    // A table and a key inside it: one would silently win.
+    let err = sweep_of(
+        grid(&["baseline"], &[Task::StopRotation]),
+        &[
+            "problem.fitness.scoring=original,evolution",
+            "problem.fitness={ kind = \"original\" },{ kind = \"incremental\" }",
+        ],
+    )
+    .unwrap_err();
+    let err = format!("{err:#}");
+    assert!(err.contains("problem.fitness") && err.contains("overlap"), "{err}");
+}
+
+#[test]
+fn a_rescoring_setting_that_changes_no_test_is_refused_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = copy_of_grid(dir.path());
+    for (toml, key) in [
+        ("[problem.noise]\ninput_sd = 0.2\n", "problem.noise.input_sd"),
+        ("[problem.noise]\noutput_sd = 0.2\n", "problem.noise.output_sd"),
+        ("[problem]\nrandom_init = true\n", "problem.random_init"),
+        ("[problem.fitness]\nkind = \"original\"\n", "problem.fitness.kind"),
+    ] {
+        let config = dir.path().join("rescore.toml");
+        std::fs::write(&config, toml).unwrap();
+        let out = dir.path().join("rescored");
+        refused(
+            &psa_esp(&[
+                "rescore",
+                source.to_str().unwrap(),
+                "--config",
+                config.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ]),
+            &[key, "changes nothing"],
+        );
+        assert!(!out.exists(), "{key}: nothing written");
+    }
+}
+
+// 4. Grids of earlier builds stay readable.
+
+/// Makes the run of the grid in `grid` look written by the build before
+/// `changed`: its config.toml without the table's keys, its run.json
+/// naming that build.
+fn age_run(grid: &Path, changed: &str) {
+    let folder = run_folder(grid);
+    let text = std::fs::read_to_string(folder.join("config.toml")).unwrap();
+    let mut table: toml::Table = toml::from_str(&text).unwrap();
+    for row in CHANGES {
+        let mut parts: Vec<&str> = row.key.split('.').collect();
+        let last = parts.pop().unwrap();
+        let mut at = Some(&mut table);
+        for part in parts {
+            at = at.and_then(|t| t.get_mut(part)).and_then(|v| v.as_table_mut());
+        }
+        if let Some(t) = at {
+            t.remove(last);
+        }
+    }
+    std::fs::write(folder.join("config.toml"), toml::to_string(&table).unwrap()).unwrap();
+    let path = folder.join("run.json");
+    let mut run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let build = run["build"].as_object_mut().unwrap();
+    build.remove("defaults");
+    build.insert("git_commit".into(), parent_of(changed).into());
+    std::fs::write(&path, serde_json::to_string_pretty(&run).unwrap()).unwrap();
+}
+
+#[test]
+fn a_grid_of_an_earlier_build_is_reported_and_resuming_it_names_the_setting_and_the_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    age_run(&grid, "a70d696");
+    let report = psa_esp(&["report", grid.to_str().unwrap(), "--format", "json"]);
+    ok(&report);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(grid.join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["runs_counted"], 1, "{}", stderr(&report));
+    let readings = json["readings"].to_string();
+    assert!(
+        readings.contains("(-pi, pi]"),
+        "the run's own heading range: {readings}"
+    );
+    // Resuming with this build's defaults: refused, naming the setting and the build.
+    refused(&psa_esp(&tiny_args(&grid)), &["heading_wrap", &parent_of("a70d696")]);
+    // Re-scoring reads it too, under its own model.
+    let config = dir.path().join("rescore.toml");
+    std::fs::write(&config, "[problem.fitness]\nscoring = \"incremental\"\n").unwrap();
+    let out = dir.path().join("rescored");
+    ok(&psa_esp(&[
+        "rescore",
+        grid.to_str().unwrap(),
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    ok(&psa_esp(&["report", out.to_str().unwrap()]));
+}
+
+// 5. Sweeps are counted before they are built.
+
+#[test]
+fn a_sweep_of_too_many_variants_is_refused_before_any_is_built() {
+    let values = |key: &str| {
+        let list: Vec<String> = (0..100).map(|i| format!("{}", 0.001 * i as f64)).collect();
+        format!("{key}={}", list.join(","))
+    };
+    let vary = [
+        values("problem.noise.input_sd"),
+        values("problem.noise.output_sd"),
+        values("problem.tasks.task3_speed"),
+        values("problem.tasks.task1_spin"),
+    ];
+    let start = Instant::now();
+    let err = sweep_of(
+        grid(&["baseline"], &[Task::StopRotation]),
+        &vary.iter().map(String::as_str).collect::<Vec<_>>(),
+    )
+    .unwrap_err();
+    let err = format!("{err:#}");
+    assert!(err.contains("100000000 variants"), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(5), "{:?}", start.elapsed());
+}
+
+// 6. One run counted once.
+
+#[test]
+fn a_configuration_or_task_listed_twice_is_refused_and_an_old_grid_counts_each_run_once() {
+    let dir = tempfile::tempdir().unwrap();
+    for (flag, list, needle) in [
+        (
+            "--configs",
+            "baseline,baseline",
+            "configuration baseline is listed twice",
+        ),
+        ("--tasks", "1,1", "task 1 is listed twice"),
+    ] {
+        let out = dir.path().join(flag.trim_start_matches('-'));
+        let mut args = tiny_args(&out);
+        let at = args.iter().position(|a| *a == flag).unwrap();
+        args[at + 1] = list;
+        refused(&psa_esp(&args), &[needle]);
+    }
+    // A grid.json that lists a configuration twice (an earlier build wrote them).
+    let grid = copy_of_grid(dir.path());
+    let path = grid.join("grid.json");
+    let mut spec: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    spec["configs"] = serde_json::json!(["baseline", "baseline"]);
+    spec["tasks"] = serde_json::json!([1, 1]);
+    std::fs::write(&path, spec.to_string()).unwrap();
+    let loaded = GridSpec::load(&grid).unwrap();
+    assert_eq!(loaded.runs().len(), 1);
+    ok(&psa_esp(&["report", grid.to_str().unwrap(), "--format", "json"]));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(grid.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["runs_counted"], 1);
+    assert_eq!(report["runs_expected"], 1);
+}
+
+// 7. A checkpoint is an input file under the rules of docs/limits.md.
+
+#[test]
+fn a_checkpoint_that_is_not_a_bounded_regular_file_is_refused_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let folder = run_folder(&grid);
+    std::fs::remove_file(folder.join("robustness.json")).unwrap();
+    let checkpoint = folder.join("checkpoint.json");
+    let mut args = tiny_args(&grid);
+    args.push("--lockstep");
+    type Make = fn(&Path);
+    let cases: [(&str, Make, &str); 4] = [
+        ("FIFO", make_fifo, "a FIFO"),
+        (
+            "link to /dev/zero",
+            |p| std::os::unix::fs::symlink("/dev/zero", p).unwrap(),
+            "symbolic link",
+        ),
+        (
+            "70 MB",
+            |p| std::fs::File::create(p).unwrap().set_len(70 << 20).unwrap(),
+            "more than",
+        ),
+        ("directory", |p| std::fs::create_dir(p).unwrap(), "a directory"),
+    ];
+    for (what, make, needle) in cases {
+        make(&checkpoint);
+        let o = run_within(&args, Duration::from_secs(60)).unwrap_or_else(|| panic!("{what}: hangs"));
+        refused(&o, &["checkpoint.json", needle]);
+        assert!(!folder.join("robustness.json").exists(), "{what}: the run was not run");
+        if checkpoint.is_dir() {
+            std::fs::remove_dir(&checkpoint).unwrap();
+        } else {
+            std::fs::remove_file(&checkpoint).unwrap();
+        }
+    }
+    // Without --lockstep too (it could be neither read nor removed).
+    std::fs::create_dir(&checkpoint).unwrap();
+    refused(&psa_esp(&tiny_args(&grid)), &["checkpoint.json"]);
+}
+
+// 8. A finished grid holds only its documented files.
+
+#[test]
+fn what_killed_processes_left_is_cleared_when_the_grid_is_resumed_or_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let folder = run_folder(&grid);
+    let expected = names_in(&folder);
+    let host = psa_esp::provenance::host_name();
+    let dead = dead_pid();
+    // A killed lockstep grid's claim on a finished run.
+    let claim = serde_json::json!({
+        "host": host,
+        "pid": dead,
+        "started": "2026-11-27T00:00:00Z",
+        "started_unix": 1_700_000_000u64,
+    });
+    std::fs::write(folder.join("claim.json"), claim.to_string()).unwrap();
+    // A checkpoint a lockstep process left.
+    std::fs::write(folder.join("checkpoint.json"), "{}").unwrap();
+    // Temporary files of killed processes, and one of a live process.
+    std::fs::write(folder.join(format!(".run.json.tmp-{host}-{dead}-0")), "x").unwrap();
+    std::fs::write(grid.join(format!(".report.md.tmp-{host}-{dead}-1")), "x").unwrap();
+    let live = format!(".grid.json.tmp-{host}-{}-2", std::process::id());
+    std::fs::write(grid.join(&live), "x").unwrap();
+    ok(&psa_esp(&tiny_args(&grid)));
+    assert_eq!(names_in(&folder), expected);
+    assert!(grid.join(&live).exists(), "a live process's file is left");
+    std::fs::write(grid.join(format!(".report.md.tmp-{host}-{dead}-3")), "x").unwrap();
+    std::fs::create_dir_all(grid.join("figures")).unwrap();
+    std::fs::write(
+        grid.join("figures").join(format!(".f.png.tmp-{host}-{dead}-4.png")),
+        "x",
+    )
+    .unwrap();
+    ok(&psa_esp(&["report", grid.to_str().unwrap()]));
+    let leftovers: Vec<String> = names_in(&grid)
+        .into_iter()
+        .chain(names_in(&grid.join("figures")))
+        .filter(|n| n.contains(&format!("-{dead}-")))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn a_run_resumed_without_lockstep_leaves_no_checkpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let folder = run_folder(&grid);
+    let expected = names_in(&folder);
+    std::fs::remove_file(folder.join("robustness.json")).unwrap();
+    std::fs::write(folder.join("checkpoint.json"), "{\"not\": \"this run\"}").unwrap();
+    ok(&psa_esp(&tiny_args(&grid)));
+    assert_eq!(names_in(&folder), expected);
+}
+
+// 9. Sweeps are checked whole before the first run.
+
+#[test]
+fn variant_names_fit_a_file_system_and_every_variant_is_checked_on_every_task() {
+    let spec = sweep_of(
+        grid(&["baseline"], &[Task::StopRotation]),
+        &[
+            "problem.tasks.task3_random_distance=[0.25,0.55],[0.3,0.5]",
+            "problem.tasks.task2_velocity=[0.0,0.0],[0.1,0.0]",
+            "problem.sensors.angular_velocity_scale=1.0,2.0",
+            "problem.sensors.position_scale=10.0,20.0",
+            "problem.fitness.heading_window=0.05,0.1",
+            "problem.fitness.box_half_width=0.05,0.1",
+            "problem.tasks.task3_target_heading=0.0,0.5",
+            "problem.tasks.task2_target_heading=1.5707963267948966,1.0",
+        ],
+    )
+    .unwrap();
+    let variants = spec.variants();
+    assert_eq!(variants.len(), 256);
+    for v in &variants {
+        assert!(v.name.len() <= MAX_VARIANT_NAME, "{} bytes: {}", v.name.len(), v.name);
+    }
+    let names: std::collections::HashSet<&str> = variants.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(names.len(), variants.len(), "names stay distinct");
+    // Random starts on task 2: refused before any run.
+    let err = sweep_of(grid(&["baseline"], &[Task::Turn]), &["problem.random_init=true,false"]).unwrap_err();
+    let err = format!("{err:#}");
+    assert!(err.contains("task 2") && err.contains("random"), "{err}");
+}
+
+// 10. Errors for the settings of network files name the key.
+
+#[test]
+fn a_bad_value_in_a_network_file_is_named_by_its_key() {
+    let dir = tempfile::tempdir().unwrap();
+    for (section, key, value) in [
+        ("sensors", "heading_wrap", serde_json::json!("both")),
+        ("sensors", "heading_input", serde_json::json!("relative")),
+        ("fitness", "scoring", serde_json::json!("best")),
+        ("fitness", "state", serde_json::json!("imagined")),
+        ("physics", "start_quaternion", serde_json::json!(7)),
+    ] {
+        let mut json = network_json(&PsaSettings::default());
+        json["problem"][section][key] = value;
+        let err = load_json(dir.path(), &json).unwrap_err();
+        assert!(err.contains(&format!("problem.{section}.{key}")), "{err}");
+    }
+    let mut json = network_json(&PsaSettings::default());
+    json["problem"]["exponential"] = "slow".into();
+    let err = load_json(dir.path(), &json).unwrap_err();
+    assert!(err.contains("problem.exponential"), "{err}");
+}
+
+// The rules of docs/limits.md for output paths and checkpoints.
+
+#[test]
+fn docs_limits_states_the_rules_for_output_paths_and_checkpoints() {
+    let doc = std::fs::read_to_string(repo("docs/limits.md")).unwrap();
+    for needle in [
+        "## Output paths",
+        "## Checkpoints",
+        "a regular file or a new name",
+        "not a directory",
+        "checkpoint.json",
+        "remove it to start the run afresh",
+        "io::check_output_file",
+        "io::create_output_dir",
+        "io::remove_stale_temporaries",
+    ] {
+        assert!(doc.contains(needle), "docs/limits.md lacks {needle:?}");
+    }
+    // The message the page quotes is the one the tool gives.
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("x.csv");
+    make_fifo(&fifo);
+    let o = psa_esp(&[
+        "simulate",
+        "--thrust",
+        "1,0,0,0",
+        "--steps",
+        "2",
+        "--out",
+        fifo.to_str().unwrap(),
+    ]);
+    let text = refused(&o, &[]);
+    let quoted = text
+        .trim()
+        .trim_start_matches("error: ")
+        .replace(fifo.to_str().unwrap(), "/tmp/x.csv");
+    assert!(doc.contains(&quoted), "docs/limits.md should quote {quoted:?}");
+}
