@@ -5,15 +5,15 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use crate::evolution::{evaluate_each, evaluate_each_part, Evaluator, Part};
-use crate::network::{Network, NetworkSet};
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
 use crate::psa::batch::LANES;
 use crate::psa::cuda::{self, HostTrials, KernelPart, TrialFlier};
 use crate::psa::ode_lockstep::ODE_LOCKSTEP;
 use crate::psa::{BatchRunner, OdeLockstepRunner, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
-use crate::rng::{Stream, StreamFamily};
+use esp_neuroevolution::network::{Network, NetworkSet};
+use esp_neuroevolution::rng::{Stream, StreamFamily};
+use esp_neuroevolution::{evaluate_each, evaluate_each_part, Evaluator, Part};
 
 /// Networks per batch on the cuda kernel: more than any run asks at once,
 /// so that a run's generation goes to the device in one launch.
@@ -41,18 +41,44 @@ pub enum EvalPath {
     Kernel(Arc<dyn TrialFlier>),
 }
 
+/// The names of the paths that need no device, fixed before and after the
+/// SIMD levels in [`EvalPath::NAMES`].
+const NAMES_BEFORE_LEVELS: [&str; 2] = ["fastest", "scalar"];
+/// See [`NAMES_BEFORE_LEVELS`].
+const NAMES_AFTER_LEVELS: [&str; 2] = ["ode-lockstep", "kernel-host"];
+
 impl EvalPath {
     /// The names `EvalPath` is read from (its `FromStr`): every path but
-    /// [`EvalPath::Kernel`], which needs a device.
-    pub const NAMES: [&'static str; 7] = [
-        "fastest",
-        "scalar",
-        "portable",
-        "avx2",
-        "avx512",
-        "ode-lockstep",
-        "kernel-host",
-    ];
+    /// [`EvalPath::Kernel`], which needs a device; a SIMD level by its
+    /// name, one for each of [`SimdLevel::ALL`].
+    pub const NAMES: [&'static str; NAMES_BEFORE_LEVELS.len() + SimdLevel::ALL.len() + NAMES_AFTER_LEVELS.len()] = {
+        let mut names = [""; NAMES_BEFORE_LEVELS.len() + SimdLevel::ALL.len() + NAMES_AFTER_LEVELS.len()];
+        let mut i = 0;
+        while i < names.len() {
+            names[i] = if i < NAMES_BEFORE_LEVELS.len() {
+                NAMES_BEFORE_LEVELS[i]
+            } else if i < NAMES_BEFORE_LEVELS.len() + SimdLevel::ALL.len() {
+                SimdLevel::ALL[i - NAMES_BEFORE_LEVELS.len()].name()
+            } else {
+                NAMES_AFTER_LEVELS[i - NAMES_BEFORE_LEVELS.len() - SimdLevel::ALL.len()]
+            };
+            i += 1;
+        }
+        names
+    };
+
+    /// The path's name, as [`EvalPath::NAMES`] spells it (`"kernel"` for
+    /// [`EvalPath::Kernel`], which has none to be read from).
+    pub fn name(&self) -> &'static str {
+        match self {
+            EvalPath::Fastest => NAMES_BEFORE_LEVELS[0],
+            EvalPath::Scalar => NAMES_BEFORE_LEVELS[1],
+            EvalPath::Simd(level) => level.name(),
+            EvalPath::OdeLockstep => NAMES_AFTER_LEVELS[0],
+            EvalPath::KernelOnHost => NAMES_AFTER_LEVELS[1],
+            EvalPath::Kernel(_) => "kernel",
+        }
+    }
 
     /// The backend the path flies on, if it needs one.
     fn backend(&self) -> Option<BackendKind> {
@@ -67,17 +93,21 @@ impl EvalPath {
 impl std::str::FromStr for EvalPath {
     type Err = String;
     fn from_str(name: &str) -> Result<EvalPath, String> {
-        match name {
-            "fastest" => Ok(EvalPath::Fastest),
-            "scalar" => Ok(EvalPath::Scalar),
-            "ode-lockstep" => Ok(EvalPath::OdeLockstep),
-            "kernel-host" => Ok(EvalPath::KernelOnHost),
-            _ => name.parse().map(EvalPath::Simd).map_err(|_| {
-                format!(
-                    "unknown evaluation path {name:?} (expected one of {})",
-                    EvalPath::NAMES.join(", ")
-                )
-            }),
+        let unknown = || {
+            format!(
+                "unknown evaluation path {name:?} (expected one of {})",
+                EvalPath::NAMES.join(", ")
+            )
+        };
+        let fixed = [
+            EvalPath::Fastest,
+            EvalPath::Scalar,
+            EvalPath::OdeLockstep,
+            EvalPath::KernelOnHost,
+        ];
+        match fixed.into_iter().find(|path| path.name() == name) {
+            Some(path) => Ok(path),
+            None => name.parse().map(EvalPath::Simd).map_err(|_| unknown()),
         }
     }
 }
@@ -115,12 +145,22 @@ pub fn trial_scores(
 pub struct PsaEvaluator {
     settings: PsaSettings,
     task: Task,
-    /// The batched runner, built once and used by every worker thread.
-    batch: Option<BatchRunner>,
-    /// Whether `ode` runs batches in lockstep (each worker its own world).
-    ode_lockstep: bool,
-    /// The cuda kernel's flier (a GPU, or the host build), where one is set (`native` only).
-    kernel: Option<Arc<dyn TrialFlier>>,
+    /// The path, resolved once from the [`EvalPath`] and the backend.
+    route: Route,
+}
+
+/// How a [`PsaEvaluator`] flies its networks: its [`EvalPath`] resolved
+/// against the settings' backend, once, when it is made.
+#[derive(Debug, Clone)]
+enum Route {
+    /// One network at a time, each worker with its own [`TrialRunner`].
+    Scalar,
+    /// `native`'s batched path, the runner shared by every worker thread.
+    Batched(BatchRunner),
+    /// `ode`'s lockstep path, each worker with its own world.
+    OdeLockstep,
+    /// The cuda kernel's flier (a GPU, or the host build), on `native`.
+    Kernel(Arc<dyn TrialFlier>),
 }
 
 /// A worker thread's state: its runners, which own the thread's physics
@@ -154,35 +194,27 @@ impl PsaEvaluator {
                 settings.backend
             );
         }
-        let native = settings.backend == BackendKind::Native;
-        let batch = match path {
-            EvalPath::Scalar | EvalPath::OdeLockstep => None,
-            EvalPath::Simd(level) => Some(BatchRunner::new(&settings, task)?.with_level(*level)),
-            EvalPath::Fastest | EvalPath::KernelOnHost | EvalPath::Kernel(_) if native => {
-                Some(BatchRunner::new(&settings, task)?)
-            }
-            EvalPath::Fastest | EvalPath::KernelOnHost | EvalPath::Kernel(_) => None,
+        let kernel = |flier: Arc<dyn TrialFlier>| -> Result<Route> {
+            // The batched runner checks the settings as the kernel's host side reads them.
+            BatchRunner::new(&settings, task)?;
+            Ok(Route::Kernel(flier))
         };
-        let ode_lockstep = match path {
-            EvalPath::Fastest => OdeLockstepRunner::supports(&settings),
+        let route = match path {
+            EvalPath::Scalar => Route::Scalar,
+            EvalPath::Simd(level) => Route::Batched(BatchRunner::new(&settings, task)?.with_level(*level)),
             EvalPath::OdeLockstep => {
                 OdeLockstepRunner::new(&settings, task)?;
-                true
+                Route::OdeLockstep
             }
-            _ => false,
+            EvalPath::KernelOnHost => kernel(Arc::new(HostTrials))?,
+            EvalPath::Kernel(flier) => kernel(flier.clone())?,
+            EvalPath::Fastest => match settings.backend {
+                BackendKind::Native => Route::Batched(BatchRunner::new(&settings, task)?),
+                BackendKind::Ode if OdeLockstepRunner::supports(&settings) => Route::OdeLockstep,
+                BackendKind::Ode | BackendKind::Rapier => Route::Scalar,
+            },
         };
-        let kernel: Option<Arc<dyn TrialFlier>> = match path {
-            EvalPath::KernelOnHost => Some(Arc::new(HostTrials)),
-            EvalPath::Kernel(flier) => Some(flier.clone()),
-            _ => None,
-        };
-        Ok(PsaEvaluator {
-            settings,
-            task,
-            batch,
-            ode_lockstep,
-            kernel,
-        })
+        Ok(PsaEvaluator { settings, task, route })
     }
 }
 
@@ -196,46 +228,45 @@ impl Evaluator for PsaEvaluator {
     }
     fn worker(&self) -> Result<PsaWorker> {
         // ODE worlds belong to their thread: make the runners here (or later, on it).
-        Ok(PsaWorker {
-            scalar: if self.batch.is_none() && !self.ode_lockstep {
-                Some(TrialRunner::new(&self.settings, self.task)?)
-            } else {
-                None
-            },
-            lockstep: None,
-        })
+        let scalar = match self.route {
+            Route::Scalar => Some(TrialRunner::new(&self.settings, self.task)?),
+            Route::Batched(_) | Route::OdeLockstep | Route::Kernel(_) => None,
+        };
+        Ok(PsaWorker { scalar, lockstep: None })
     }
     fn evaluate(&self, worker: &mut PsaWorker, network: &Network, rng: &mut Stream) -> Result<f64> {
         Ok(self.scalar(worker)?.evaluate(network, rng)?)
     }
     fn batch_size(&self) -> usize {
-        if self.kernel.is_some() {
-            CUDA_BATCH
-        } else if self.batch.is_some() {
-            LANES
-        } else if self.ode_lockstep {
-            ODE_LOCKSTEP
-        } else {
-            1
+        match self.route {
+            Route::Scalar => 1,
+            Route::Batched(_) => LANES,
+            Route::OdeLockstep => ODE_LOCKSTEP,
+            Route::Kernel(_) => CUDA_BATCH,
         }
     }
     fn narrowest_batch(&self) -> usize {
-        if self.kernel.is_some() {
+        match &self.route {
+            Route::Scalar | Route::OdeLockstep => 1,
+            Route::Batched(batch) => batch.narrowest_block(),
             // A generation goes to the device whole, not cut between the threads.
-            return CUDA_BATCH;
+            Route::Kernel(_) => CUDA_BATCH,
         }
-        self.batch.as_ref().map_or(1, BatchRunner::narrowest_block)
     }
     fn takes_parts_together(&self) -> bool {
-        self.kernel.is_some()
+        match self.route {
+            Route::Scalar | Route::Batched(_) | Route::OdeLockstep => false,
+            Route::Kernel(_) => true,
+        }
     }
     fn evaluate_parts<S: NetworkSet + ?Sized>(
         &self,
         worker: &mut PsaWorker,
         parts: &[Part<'_, S>],
     ) -> Vec<Result<Vec<f64>>> {
-        let Some(flier) = &self.kernel else {
-            return evaluate_each_part(self, worker, parts);
+        let flier = match &self.route {
+            Route::Scalar | Route::Batched(_) | Route::OdeLockstep => return evaluate_each_part(self, worker, parts),
+            Route::Kernel(flier) => flier,
         };
         // Every part's trials in one flight of the kernel: one GPU launch.
         let mut rngs: Vec<Vec<Stream>> = parts
@@ -266,11 +297,13 @@ impl Evaluator for PsaEvaluator {
         range: Range<usize>,
         streams: &StreamFamily,
     ) -> Result<Vec<f64>> {
-        if self.kernel.is_none() && self.batch.is_none() && !self.ode_lockstep {
-            return evaluate_each(self, worker, networks, range, streams);
+        match self.route {
+            Route::Scalar => evaluate_each(self, worker, networks, range, streams),
+            Route::Batched(_) | Route::OdeLockstep | Route::Kernel(_) => {
+                let mut rngs: Vec<Stream> = range.clone().map(|j| streams.stream(j)).collect();
+                self.evaluate_with_streams(worker, networks, range, &mut rngs)
+            }
         }
-        let mut rngs: Vec<Stream> = range.clone().map(|j| streams.stream(j)).collect();
-        self.evaluate_with_streams(worker, networks, range, &mut rngs)
     }
 }
 
@@ -295,25 +328,49 @@ impl PsaEvaluator {
         rngs: &mut [Stream],
     ) -> Result<Vec<f64>> {
         assert_eq!(range.len(), rngs.len(), "one stream per network");
-        if let Some(flier) = &self.kernel {
-            let (settings, task) = (&self.settings, self.task);
-            return Ok(cuda::evaluate_with(settings, task, networks, range, rngs, |batch| {
-                flier.fly(batch)
-            })?);
-        }
-        if let Some(batch) = &self.batch {
-            return Ok(batch.evaluate(networks, range, rngs)?);
-        }
-        if self.ode_lockstep {
-            if worker.lockstep.is_none() {
-                worker.lockstep = Some(OdeLockstepRunner::new(&self.settings, self.task)?);
+        match &self.route {
+            Route::Kernel(flier) => {
+                let (settings, task) = (&self.settings, self.task);
+                Ok(cuda::evaluate_with(settings, task, networks, range, rngs, |batch| {
+                    flier.fly(batch)
+                })?)
             }
-            let lockstep = worker.lockstep.as_mut().expect("just made");
-            return Ok(lockstep.evaluate(networks, range, rngs)?);
+            Route::Batched(batch) => Ok(batch.evaluate(networks, range, rngs)?),
+            Route::OdeLockstep => {
+                if worker.lockstep.is_none() {
+                    worker.lockstep = Some(OdeLockstepRunner::new(&self.settings, self.task)?);
+                }
+                let lockstep = worker.lockstep.as_mut().expect("just made");
+                Ok(lockstep.evaluate(networks, range, rngs)?)
+            }
+            Route::Scalar => range
+                .zip(rngs)
+                .map(|(j, rng)| self.evaluate(worker, &networks.network(j), rng))
+                .collect(),
         }
-        range
-            .zip(rngs)
-            .map(|(j, rng)| self.evaluate(worker, &networks.network(j), rng))
-            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_reads_back_as_the_path_of_that_name() {
+        for name in EvalPath::NAMES {
+            let path: EvalPath = name.parse().unwrap();
+            assert_eq!(path.name(), name);
+        }
+        let levels: Vec<&str> = SimdLevel::ALL.iter().map(|l| l.name()).collect();
+        assert!(
+            levels.iter().all(|l| EvalPath::NAMES.contains(l)),
+            "{:?}",
+            EvalPath::NAMES
+        );
+        let mut unique = EvalPath::NAMES.to_vec();
+        unique.sort_unstable();
+        unique.dedup();
+        assert_eq!(unique.len(), EvalPath::NAMES.len());
+        assert!("kernel".parse::<EvalPath>().unwrap_err().contains("kernel-host"));
     }
 }

@@ -17,14 +17,14 @@ use serde::Serialize;
 use super::bench_kernel::{kernel_rows, KernelBench, KERNEL_NETWORKS};
 use super::bench_networks::{random_networks, HIDDEN};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
-use crate::evaluator::{EvalPath, PsaEvaluator};
-use crate::evolution::evaluate_all;
-use crate::experiment::PAPER_NOISE_SD;
-use crate::network::Network;
-use crate::numeric::{sigmoid, Lanes, SimdLevel};
-use crate::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
-use crate::psa::batch::LANES;
-use crate::psa::{BodySettings, PsaSettings, Task, THRUSTER_COUNT};
+use esp_neuroevolution::evaluate_all;
+use esp_neuroevolution::network::Network;
+use psa_experiment::PAPER_NOISE_SD;
+use psa_sim::evaluator::{EvalPath, PsaEvaluator};
+use psa_sim::numeric::{sigmoid, Lanes, SimdLevel};
+use psa_sim::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
+use psa_sim::psa::batch::LANES;
+use psa_sim::psa::{BodySettings, PsaSettings, Task, THRUSTER_COUNT};
 
 /// Arguments of `bench`.
 #[derive(Debug, clap::Args)]
@@ -60,28 +60,46 @@ pub struct BenchArgs {
     pub json: bool,
 }
 
-/// A way of evaluating networks: a backend, on `native` the scalar
-/// reference or the batched path on one SIMD level, on `ode` one world per
-/// network or the lockstep path (many bodies in one world).
-#[derive(Debug, Clone, Copy, Serialize)]
+/// A way of evaluating networks: a backend and the [`EvalPath`] on it (on
+/// `native` the scalar reference or the batched path on one SIMD level, on
+/// `ode` one world per network or the lockstep path, many bodies in one
+/// world), with or without input noise. Written to JSON as `backend`,
+/// `simd` (the batched path's level, `null` otherwise), `ode_lockstep` and
+/// `input_noise`.
+#[derive(Debug, Clone)]
 pub struct EvaluationPath {
     /// The physics backend.
     pub backend: BackendKind,
-    /// The batched path's SIMD level; `None` for the scalar path.
-    pub simd: Option<SimdLevel>,
-    /// On `ode`, the lockstep path; otherwise one world per network.
-    pub ode_lockstep: bool,
+    /// The path on it: [`EvalPath::Scalar`], [`EvalPath::Simd`] or
+    /// [`EvalPath::OdeLockstep`].
+    pub path: EvalPath,
     /// Under the paper's input noise (sd 0.05), as in its noisy configurations.
     pub input_noise: bool,
+}
+
+impl Serialize for EvaluationPath {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let simd = match self.path {
+            EvalPath::Simd(level) => Some(level),
+            _ => None,
+        };
+        let mut row = serializer.serialize_struct("EvaluationPath", 4)?;
+        row.serialize_field("backend", &self.backend)?;
+        row.serialize_field("simd", &simd)?;
+        row.serialize_field("ode_lockstep", &matches!(self.path, EvalPath::OdeLockstep))?;
+        row.serialize_field("input_noise", &self.input_noise)?;
+        row.end()
+    }
 }
 
 impl EvaluationPath {
     /// The path's name in the bench's table.
     pub fn label(&self) -> String {
-        let path = match (self.backend, self.simd) {
-            (BackendKind::Native, None) => "native scalar".into(),
-            (BackendKind::Native, Some(level)) => format!("native batched {level}"),
-            (BackendKind::Ode, _) if self.ode_lockstep => "ode lockstep".into(),
+        let path = match (self.backend, &self.path) {
+            (BackendKind::Native, EvalPath::Simd(level)) => format!("native batched {level}"),
+            (BackendKind::Ode, EvalPath::OdeLockstep) => "ode lockstep".into(),
+            (BackendKind::Native, _) => "native scalar".into(),
             (BackendKind::Ode, _) => "ode one world each".into(),
             (backend, _) => backend.name().into(),
         };
@@ -96,42 +114,34 @@ impl EvaluationPath {
     /// batched on every level the CPU has, rapier; then native scalar and
     /// batched on the CPU's best level under input noise.
     pub fn all() -> Vec<EvaluationPath> {
+        let on = |backend, path| EvaluationPath {
+            backend,
+            path,
+            input_noise: false,
+        };
         let mut paths = Vec::new();
         for backend in BackendKind::available() {
-            let path = EvaluationPath {
-                backend,
-                simd: None,
-                ode_lockstep: false,
-                input_noise: false,
-            };
-            paths.push(path);
-            if backend == BackendKind::Ode {
-                paths.push(EvaluationPath {
-                    ode_lockstep: true,
-                    ..path
-                });
-            }
-            if backend == BackendKind::Native {
-                paths.extend(
+            paths.push(on(backend, EvalPath::Scalar));
+            match backend {
+                BackendKind::Ode => paths.push(on(backend, EvalPath::OdeLockstep)),
+                BackendKind::Native => paths.extend(
                     SimdLevel::ALL
                         .into_iter()
                         .filter(|l| l.is_supported())
-                        .map(|level| EvaluationPath {
-                            simd: Some(level),
-                            ..path
-                        }),
-                );
+                        .map(|level| on(backend, EvalPath::Simd(level))),
+                ),
+                BackendKind::Rapier => {}
             }
         }
         let native = |p: &&EvaluationPath| p.backend == BackendKind::Native;
-        let scalar = paths.iter().find(|p| native(p) && p.simd.is_none());
-        let best_batched = paths.iter().rfind(|p| native(p) && p.simd.is_some());
+        let scalar = paths.iter().find(|p| native(p) && matches!(p.path, EvalPath::Scalar));
+        let best_batched = paths.iter().rfind(|p| native(p) && matches!(p.path, EvalPath::Simd(_)));
         let noisy: Vec<_> = [scalar, best_batched]
             .into_iter()
             .flatten()
-            .map(|&path| EvaluationPath {
+            .map(|path| EvaluationPath {
                 input_noise: true,
-                ..path
+                ..path.clone()
             })
             .collect();
         paths.extend(noisy);
@@ -147,12 +157,7 @@ impl EvaluationPath {
         if self.input_noise {
             settings.noise.input_sd = PAPER_NOISE_SD;
         }
-        let path = match (self.simd, self.ode_lockstep) {
-            (Some(level), _) => EvalPath::Simd(level),
-            (None, true) => EvalPath::OdeLockstep,
-            (None, false) => EvalPath::Scalar,
-        };
-        PsaEvaluator::new(settings, Task::StopRotation, &path)
+        PsaEvaluator::new(settings, Task::StopRotation, &self.path)
     }
 }
 
@@ -168,9 +173,9 @@ struct EvaluationTiming {
 
 /// Evaluations per second of `networks` on task 1 with `threads` threads
 /// (median of `rounds` rounds).
-fn evaluations_per_second(path: EvaluationPath, networks: &[Network], threads: usize, rounds: u64) -> Result<f64> {
+fn evaluations_per_second(path: &EvaluationPath, networks: &[Network], threads: usize, rounds: u64) -> Result<f64> {
     let evaluator = path.evaluator()?;
-    let pool = crate::ode::thread_pool(threads)?;
+    let pool = psa_sim::ode::thread_pool(threads)?;
     let mut rates = Vec::new();
     for round in 0..rounds {
         let start = Instant::now();
@@ -191,16 +196,22 @@ struct LogisticTiming {
     percent_of_batched_network_step: f64,
 }
 
-/// Applies the logistic function `rounds` times over to every value, on the
-/// CPU's best SIMD level.
-#[multiversion(targets("x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl", "x86_64+avx2+fma"))]
-pub fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
-    for _ in 0..rounds {
-        for v in values.iter_mut() {
-            *v = sigmoid(*v);
+/// Declares `logistic_rounds`, compiled for the batched path's targets.
+macro_rules! logistic_rounds {
+    ($avx512:tt, $avx2:tt) => {
+        /// Applies the logistic function `rounds` times over to every value, on the
+        /// CPU's best SIMD level.
+        #[multiversion(targets($avx512, $avx2))]
+        pub fn logistic_rounds(values: &mut [Lanes<LANES>], rounds: usize) {
+            for _ in 0..rounds {
+                for v in values.iter_mut() {
+                    *v = sigmoid(*v);
+                }
+            }
         }
-    }
+    };
 }
+psa_sim::with_simd_targets!(logistic_rounds!());
 
 /// Blocks of [`LANES`] values in the logistic function's benchmark (16 KiB,
 /// which stay in the first-level cache).
@@ -307,7 +318,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
         return Ok(0);
     }
     let model = BodySettings::default().model()?;
-    let settings = crate::physics::StepSettings::default();
+    let settings = psa_sim::physics::StepSettings::default();
     let commands = random_thrust_sequence(1, 0, 500, model.thrusters.len());
     let kinds = BackendKind::available();
     let mut backends = kinds
@@ -350,8 +361,8 @@ pub fn run(args: BenchArgs) -> Result<i32> {
     let evaluations = EvaluationPath::all()
         .into_iter()
         .map(|path| {
-            let one = evaluations_per_second(path, &networks, 1, args.rounds)?;
-            let two = evaluations_per_second(path, &networks, 2, args.rounds)?;
+            let one = evaluations_per_second(&path, &networks, 1, args.rounds)?;
+            let two = evaluations_per_second(&path, &networks, 2, args.rounds)?;
             Ok(EvaluationTiming {
                 path,
                 evaluations_per_second_1_thread: one,
@@ -364,7 +375,7 @@ pub fn run(args: BenchArgs) -> Result<i32> {
     let lockstep = super::bench_ode::lockstep_by_world_size(&networks, args.rounds)?;
     let best_batched = evaluations
         .iter()
-        .filter(|e| e.path.simd.is_some() && !e.path.input_noise)
+        .filter(|e| matches!(e.path.path, EvalPath::Simd(_)) && !e.path.input_noise)
         .map(|e| e.ns_per_network_step_1_thread)
         .next_back();
     let logistic_ns = logistic_ns_per_value(args.rounds);

@@ -25,7 +25,7 @@ mod lanes;
 mod math;
 mod normal;
 
-pub use dispatch::SimdLevel;
+pub use dispatch::{SimdLevel, AVX2_TARGET, AVX512_TARGET};
 use esp_neuroevolution::math::TWO_52;
 pub use esp_neuroevolution::math::{Exponential, Float};
 pub use lanes::{LaneMask, Lanes, Words};

@@ -12,7 +12,7 @@
 //! [`SensorSettings::inputs_from`](super::SensorSettings::inputs_from) and
 //! [`FitnessSettings::points`](super::FitnessSettings::points), and the
 //! network's summation order (see
-//! [`Network::activate`](crate::network::Network::activate)). So a
+//! [`Network::activate`](esp_neuroevolution::network::Network::activate)). So a
 //! network's fitness is bit-identical on both paths and on every
 //! [`SimdLevel`]; the tests hold the paths to that on thousands of random
 //! networks. The weights are read in place from any [`NetworkSet`], such
@@ -32,12 +32,12 @@ use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use std::ops::Range;
 
-use crate::network::NetworkSet;
 use crate::numeric::{
     clamp_unit, sigmoid_with, Exponential, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words,
 };
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
-use crate::rng::Stream;
+use esp_neuroevolution::network::NetworkSet;
+use esp_neuroevolution::rng::Stream;
 
 /// Networks evaluated in lockstep by one call of the kernel: four AVX-512
 /// registers per value, enough independent work to hide the latency of the
@@ -339,18 +339,12 @@ macro_rules! kernel {
 /// neurons at a time on AVX-512 and `$g256` on AVX2 (one at a time on the
 /// portable build), and `run`, which runs the one asked for.
 macro_rules! kernels {
-    ($module:ident, $n:expr, $noisy:expr, $g512:expr, $g256:expr) => {
+    ($module:ident, $n:expr, $noisy:expr, $g512:expr, $g256:expr, $avx512:tt, $avx2:tt) => {
         mod $module {
             use super::*;
 
-            kernel!(
-                avx512,
-                "x86_64+avx512f+avx512bw+avx512cd+avx512dq+avx512vl",
-                $n,
-                $g512,
-                $noisy
-            );
-            kernel!(avx2, "x86_64+avx2+fma", $n, $g256, $noisy);
+            kernel!(avx512, $avx512, $n, $g512, $noisy);
+            kernel!(avx2, $avx2, $n, $g256, $noisy);
             kernel!(portable, $n, 1, $noisy);
 
             pub(super) fn run(
@@ -370,12 +364,12 @@ macro_rules! kernels {
     };
 }
 
-kernels!(wide, LANES, false, 2, 1);
-kernels!(wide_noisy, LANES, true, 2, 1);
-kernels!(narrow, NARROW_LANES, false, 5, 1);
-kernels!(narrow_noisy, NARROW_LANES, true, 5, 1);
-kernels!(small, SMALL_LANES, false, 5, 1);
-kernels!(small_noisy, SMALL_LANES, true, 5, 1);
+crate::with_simd_targets!(kernels!(wide, LANES, false, 2, 1,));
+crate::with_simd_targets!(kernels!(wide_noisy, LANES, true, 2, 1,));
+crate::with_simd_targets!(kernels!(narrow, NARROW_LANES, false, 5, 1,));
+crate::with_simd_targets!(kernels!(narrow_noisy, NARROW_LANES, true, 5, 1,));
+crate::with_simd_targets!(kernels!(small, SMALL_LANES, false, 5, 1,));
+crate::with_simd_targets!(kernels!(small_noisy, SMALL_LANES, true, 5, 1,));
 
 /// A kernel of width N run on a [`SimdLevel`].
 type Kernel<const N: usize> = fn(

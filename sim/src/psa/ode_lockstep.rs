@@ -26,10 +26,10 @@ use multiversion::multiversion;
 use super::step::{score, sense, Reading};
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
 use super::{Target, Task, INPUT_COUNT, THRUSTER_COUNT};
-use crate::network::{Network, NetworkSet};
 use crate::numeric::{clamp_unit, NoiseSource};
 use crate::physics::{BackendKind, OdeFleet, PlanarState};
-use crate::rng::Stream;
+use esp_neuroevolution::network::{Network, NetworkSet};
+use esp_neuroevolution::rng::Stream;
 
 /// Networks flown in one ODE world at a time. From 8 bodies a world up,
 /// the cost per network-step is flat (`psa-esp bench`, docs/performance.md);
@@ -170,16 +170,16 @@ impl<'n> Lane<'n> {
 /// and without noise, and with AVX2 and FMA where the CPU has them (the
 /// same results either way).
 macro_rules! lockstep_loop {
-    ($name:ident, $noisy:expr) => {
-        #[multiversion(targets("x86_64+avx2+fma"))]
+    ($name:ident, $noisy:expr, $avx512:tt, $avx2:tt) => {
+        #[multiversion(targets($avx2))]
         fn $name<'n>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &mut [Lane<'n>]) -> Result<(), PsaError> {
             fly_steps::<$noisy>(s, fleet, lanes)
         }
     };
 }
 
-lockstep_loop!(fly_clean, false);
-lockstep_loop!(fly_noisy, true);
+crate::with_simd_targets!(lockstep_loop!(fly_clean, false,));
+crate::with_simd_targets!(lockstep_loop!(fly_noisy, true,));
 
 /// The loop of `fly_clean` and `fly_noisy`: per lane, the steps of the
 /// scalar path's `fly_steps` in [`super::trial`], with one fleet step for
