@@ -2,15 +2,13 @@
 //! batched path's tests and the `cuda` kernel's (on the host and on a GPU).
 #![allow(dead_code)] // each test file uses its own share
 
-use psa_esp::network::Network;
-use psa_esp::numeric::Exponential;
-use psa_esp::physics::BackendKind;
-use psa_esp::psa::cuda::{evaluate_with, TrialBatch, TrialPoints};
-use psa_esp::psa::{
-    FitnessKind, FitnessState, HeadingInput, HeadingWrap, NoiseSettings, PsaError, PsaSettings, Scoring, Task,
-    TaskOverrides, TrialRunner,
-};
-use psa_esp::rng::{stream, Stream};
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::{stream, Stream};
+use psa_sim::numeric::Exponential;
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::cuda::{evaluate_with, TrialBatch, TrialPoints};
+use psa_sim::psa::readings::every_test_value;
+use psa_sim::psa::{FitnessKind, NoiseSettings, PsaError, PsaSettings, Task, TrialRunner};
 use rand::RngExt;
 
 /// A random 7-H-4 network: H in 1..=9, weights uniform in a range of scale
@@ -58,24 +56,16 @@ pub fn original_fitness_settings() -> PsaSettings {
     original
 }
 
-/// Every reading of the inputs and the fitness that is not the default,
-/// together: the heading input absolute and wrapped to (-pi, pi], the
-/// fitness read from the sensed state, and task 3 evolved on the original
-/// fitness over 250 steps (task 1 scored on it, which the evaluation paths
-/// ignore); first with noise on every input, the bias included, outputs
-/// and random starts, then clean.
+/// Every reading of the inputs and the fitness at a value other than its
+/// default, together: the test value of each row of
+/// [`READINGS`](psa_sim::psa::readings::READINGS) (with the table's rows
+/// today: the heading input absolute and wrapped to (-pi, pi], the signed
+/// slowing rule, the fitness read from the true state, task 3 evolved on
+/// the original fitness over 250 steps, task 1 scored on the incremental
+/// one, which the evaluation paths ignore); first with noise on every
+/// input, the bias included, outputs and random starts, then clean.
 pub fn reading_settings() -> [(&'static str, PsaSettings); 2] {
-    let mut readings = noisy_settings();
-    readings.noise.on_bias = true;
-    readings.sensors.heading_input = HeadingInput::Absolute;
-    readings.sensors.heading_wrap = HeadingWrap::Symmetric;
-    readings.fitness.state = FitnessState::Sensed;
-    readings.task3 = TaskOverrides {
-        steps: Some(250),
-        fitness: Some(FitnessKind::Original),
-        scoring: None,
-    };
-    readings.task1.scoring = Some(Scoring::Original);
+    let readings = every_test_value(noisy_settings());
     let clean = PsaSettings {
         noise: NoiseSettings::default(),
         random_init: false,

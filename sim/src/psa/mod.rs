@@ -10,6 +10,7 @@ pub mod fitness;
 pub mod limits;
 pub mod network_file;
 pub mod ode_lockstep;
+pub mod readings;
 pub mod sensors;
 pub mod step;
 pub mod task;

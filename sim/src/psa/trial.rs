@@ -6,14 +6,15 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::fitness::{FitnessKind, FitnessSettings, Scoring};
+use super::readings::{Describe, READINGS};
 use super::sensors::{NoiseSettings, SensorSettings, INPUT_COUNT};
 use super::step::{score, sense};
 use super::task::{Target, Task, TaskSettings};
 use super::{BodySettings, THRUSTER_COUNT};
-use crate::network::Network;
 use crate::numeric::{clamp_unit, Exponential, NoiseSource};
 use crate::physics::{create_backend, BackendKind, BodyState, PhysicsBackend, PhysicsError, StepSettings};
-use crate::rng::Stream;
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::Stream;
 
 /// Errors of the PSA problem.
 #[derive(Debug, Error)]
@@ -184,16 +185,22 @@ impl PsaSettings {
     /// overrides in place of the problem-wide values (and none left).
     pub fn for_task(&self, task: Task) -> Result<PsaSettings, PsaError> {
         self.validate_for(task)?;
-        let overrides = *self.overrides(task);
+        // Every override by name, with no `..`: a new one is a compile
+        // error here until it is resolved.
+        let TaskOverrides {
+            steps,
+            fitness,
+            scoring,
+        } = *self.overrides(task);
         let mut resolved = PsaSettings {
             task1: TaskOverrides::default(),
             task2: TaskOverrides::default(),
             task3: TaskOverrides::default(),
             ..self.clone()
         };
-        resolved.steps = overrides.steps.unwrap_or(self.steps);
-        resolved.fitness.kind = overrides.fitness.unwrap_or(self.fitness.kind);
-        resolved.fitness.scoring = overrides.scoring.unwrap_or(self.fitness.scoring);
+        resolved.steps = steps.unwrap_or(self.steps);
+        resolved.fitness.kind = fitness.unwrap_or(self.fitness.kind);
+        resolved.fitness.scoring = scoring.unwrap_or(self.fitness.scoring);
         Ok(resolved)
     }
 
@@ -208,49 +215,19 @@ impl PsaSettings {
     }
 
     /// The readings of the inputs and the fitness these settings fly, in
-    /// words, for reports: per task the fitness evolved on, the trial's
-    /// length and the fitness champions are scored on under `scoring` (these
-    /// settings, or the ones a re-scored grid tests with); the heading
-    /// input; the noise on the bias; the state the fitness reads.
+    /// words, for reports: the lines of every row of [`READINGS`] in order
+    /// (per task the fitness evolved on, the trial's length and the fitness
+    /// champions are scored on under `scoring`, these settings or the ones
+    /// a re-scored grid tests with; the heading input; the noise on the
+    /// bias; the state the fitness reads).
     pub fn describe_readings(&self, scoring: &PsaSettings) -> Vec<String> {
-        let name = |kind: FitnessKind| match kind {
-            FitnessKind::Incremental => "incremental",
-            FitnessKind::Original => "original",
-        };
-        let mut lines: Vec<String> = Task::ALL
+        READINGS
             .iter()
-            .filter_map(|&task| {
-                let s = self.for_task(task).ok()?;
-                let scored = scoring.scoring_for(task).ok()?;
-                Some(format!(
-                    "task {task}: evolved on the {} fitness over {} steps, scored on the {}",
-                    name(s.fitness.kind),
-                    s.steps,
-                    name(scored.fitness.kind)
-                ))
+            .flat_map(|row| match row.describe {
+                Describe::Lines(lines) => lines(self, scoring),
+                Describe::With(_) => Vec::new(),
             })
-            .collect();
-        let heading = match self.sensors.heading_input {
-            super::HeadingInput::Error => "the heading error",
-            super::HeadingInput::Absolute => "the absolute heading",
-        };
-        let range = match self.sensors.heading_wrap {
-            super::HeadingWrap::Symmetric => "(-pi, pi]",
-            super::HeadingWrap::Positive => "[0, 2 pi)",
-        };
-        lines.push(format!("heading input: {heading} in {range}"));
-        lines.push(format!(
-            "input noise on the bias: {}",
-            if self.noise.on_bias { "yes" } else { "no" }
-        ));
-        lines.push(format!(
-            "the fitness reads the {} state",
-            match self.fitness.state {
-                super::FitnessState::True => "true",
-                super::FitnessState::Sensed => "sensed",
-            }
-        ));
-        lines
+            .collect()
     }
 
     /// Whether a champion of `task` is scored with another fitness than it
@@ -377,8 +354,8 @@ impl TrialRunner {
 /// is a call to Rust's `fma` function. Both give the same results; only the
 /// speed differs.
 macro_rules! trial_loop {
-    ($name:ident, $noisy:expr) => {
-        #[multiversion(targets("x86_64+avx2+fma"))]
+    ($name:ident, $noisy:expr, $avx512:tt, $avx2:tt) => {
+        #[multiversion(targets($avx2))]
         fn $name(
             s: &PsaSettings,
             backend: &mut dyn PhysicsBackend,
@@ -392,8 +369,8 @@ macro_rules! trial_loop {
     };
 }
 
-trial_loop!(fly_clean, false);
-trial_loop!(fly_noisy, true);
+crate::with_simd_targets!(trial_loop!(fly_clean, false,));
+crate::with_simd_targets!(trial_loop!(fly_noisy, true,));
 
 /// The loop of `fly_clean` and `fly_noisy`, with noise if `NOISY`.
 #[inline(always)]

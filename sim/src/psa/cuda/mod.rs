@@ -30,11 +30,12 @@ pub use device::{
 };
 pub use host::fly_on_host;
 
+use super::readings::READINGS;
 use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
-use super::{FitnessKind, FitnessState, HeadingInput, HeadingWrap, SlowingRule, Task, INPUT_COUNT, THRUSTER_COUNT};
-use crate::network::{Network, NetworkSet};
+use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
-use crate::rng::{expand, Stream};
+use esp_neuroevolution::network::{Network, NetworkSet};
+use esp_neuroevolution::rng::{expand, Stream};
 
 /// Genes of a hidden neuron: its input weights, then its output weights.
 const GENES: usize = INPUT_COUNT + THRUSTER_COUNT;
@@ -87,12 +88,8 @@ pub struct Specialisation {
     /// Hidden neurons a network of the launch has at most (at least 1).
     pub hidden: usize,
     noisy: bool,
-    incremental: bool,
-    signed_slowing: bool,
-    heading_absolute: bool,
-    heading_positive: bool,
-    bias_noise: bool,
-    fitness_sensed: bool,
+    /// Each reading's define and its value ([`READINGS`]' rows with one).
+    readings: Vec<(&'static str, bool)>,
     force_support: [i32; THRUSTER_COUNT],
     arm_support: [i32; THRUSTER_COUNT],
     exp_q: Vec<f64>,
@@ -107,22 +104,17 @@ impl Specialisation {
         let flag = |name: &str, on: bool| format!("-D{name}={}", u8::from(on));
         let ints = |values: &[i32]| values.iter().map(i32::to_string).collect::<Vec<_>>().join(",");
         let floats = |values: &[f64]| values.iter().map(|&v| hex_float(v)).collect::<Vec<_>>().join(",");
-        vec![
-            format!("-DPSA_HIDDEN={}", self.hidden),
-            flag("PSA_NOISY", self.noisy),
-            flag("PSA_INCREMENTAL", self.incremental),
-            flag("PSA_SIGNED_SLOWING", self.signed_slowing),
-            flag("PSA_HEADING_ABSOLUTE", self.heading_absolute),
-            flag("PSA_HEADING_POSITIVE", self.heading_positive),
-            flag("PSA_BIAS_NOISE", self.bias_noise),
-            flag("PSA_FITNESS_SENSED", self.fitness_sensed),
+        let mut defines = vec![format!("-DPSA_HIDDEN={}", self.hidden), flag("PSA_NOISY", self.noisy)];
+        defines.extend(self.readings.iter().map(|&(name, on)| flag(name, on)));
+        defines.extend([
             format!("-DPSA_FORCE_SUPPORT={}", ints(&self.force_support)),
             format!("-DPSA_ARM_SUPPORT={}", ints(&self.arm_support)),
             format!("-DPSA_EXP_TERMS={}", self.exp_q.len()),
             format!("-DPSA_EXP_Q={}", floats(&self.exp_q)),
             format!("-DPSA_LN2_TERMS={}", self.ln2_parts.len()),
             format!("-DPSA_LN2_PARTS={}", floats(&self.ln2_parts)),
-        ]
+        ]);
+        defines
     }
 
     /// The specialisation's name: its options in one line, the key of a
@@ -228,12 +220,10 @@ impl KernelParams {
         let specialisation = Specialisation {
             hidden: hidden.max(1),
             noisy: settings.noise.is_active(),
-            incremental: f.kind == FitnessKind::Incremental,
-            signed_slowing: f.slowing == SlowingRule::Signed,
-            heading_absolute: s.heading_input == HeadingInput::Absolute,
-            heading_positive: s.heading_wrap == HeadingWrap::Positive,
-            bias_noise: settings.noise.on_bias,
-            fitness_sensed: f.state == FitnessState::Sensed,
+            readings: READINGS
+                .iter()
+                .filter_map(|row| row.define.map(|define| (define.name, (define.on)(settings))))
+                .collect(),
             force_support: std::array::from_fn(|i| t[i].force_support),
             arm_support: std::array::from_fn(|i| t[i].arm_support),
             exp_q: settings.exponential.coefficients().to_vec(),
