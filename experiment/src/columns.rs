@@ -56,7 +56,7 @@ mod tests {
     fn docs_file_formats_lists_every_column_of_records_and_runs_csv() {
         let docs = include_str!("../../docs/file-formats.md");
         for (file, table) in [
-            ("records.csv", markdown(&crate::run::RECORD_COLUMNS)),
+            (crate::RunFiles::RECORDS, markdown(&crate::run::RECORD_COLUMNS)),
             ("runs.csv", markdown(&crate::runs_table::RUN_COLUMNS)),
         ] {
             assert!(

@@ -17,9 +17,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{GridConfig, RunConfig};
-use crate::physics::BackendKind;
-use crate::psa::Task;
+use super::{GridConfig, RunConfig, RunFiles};
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::Task;
 
 /// The `format` of `grid.json`.
 pub const GRID_FORMAT: &str = "psa-esp-grid";
@@ -161,8 +161,8 @@ impl GridSpec {
         if self.configs.is_empty() || self.tasks.is_empty() {
             bail!("the grid needs at least one configuration and one task");
         }
-        let max_generations = crate::evolution::MAX_GENERATIONS;
-        let max_trials = crate::psa::limits::MAX_TRIALS;
+        let max_generations = esp_neuroevolution::MAX_GENERATIONS;
+        let max_trials = psa_sim::psa::limits::MAX_TRIALS;
         for (name, value, max) in [
             ("seeds", self.seeds, MAX_SEEDS),
             ("generations", self.generations as u64, max_generations as u64),
@@ -271,10 +271,14 @@ impl GridSpec {
     /// at `placement` wrote it: [`GridSpec::run_config`] with every setting
     /// of the table of defaults (`psa::defaults`) at that build's value,
     /// under the grid's overrides. An error when the build cannot be placed.
-    pub fn run_config_at(&self, config: GridConfig, placement: &crate::psa::defaults::Placement) -> Result<RunConfig> {
+    pub fn run_config_at(
+        &self,
+        config: GridConfig,
+        placement: &psa_sim::psa::defaults::Placement,
+    ) -> Result<RunConfig> {
         let mut table = toml::Table::try_from(RunConfig::default())?;
-        for row in crate::psa::defaults::CHANGES {
-            let value = crate::psa::defaults::value_at(row.key, placement).map_err(anyhow::Error::msg)?;
+        for row in psa_sim::psa::defaults::CHANGES {
+            let value = psa_sim::psa::defaults::value_at(row.key, placement).map_err(anyhow::Error::msg)?;
             if let Some(value) = value {
                 let value: toml::Value = serde_json::from_value(value)?;
                 set_leaf(&mut table, row.key, value);
@@ -332,14 +336,14 @@ impl GridSpec {
     /// Reads `DIR/grid.json`, checking its format and version.
     pub fn load(dir: &Path) -> Result<GridSpec> {
         let path = grid_file(dir);
-        let spec: GridSpec = crate::io::read_versioned_json(&path, GRID_FORMAT, GRID_VERSION, "grid")?;
+        let spec: GridSpec = psa_sim::io::read_versioned_json(&path, GRID_FORMAT, GRID_VERSION, "grid")?;
         spec.validate().with_context(|| format!("{}", path.display()))?;
         Ok(spec)
     }
 
     /// Writes `DIR/grid.json` atomically.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        crate::io::write_json(&grid_file(dir), self)
+        psa_sim::io::write_json(&grid_file(dir), self)
     }
 }
 
@@ -386,7 +390,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
     if !folder.exists() {
         return Ok(RunStatus::Missing);
     }
-    let config_path = folder.join("config.toml");
+    let config_path = RunFiles::in_dir(&folder).config;
     if !config_path.exists() {
         // Killed before its first file: nothing of value in it.
         return Ok(RunStatus::Unfinished);
@@ -432,7 +436,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
             }
             // A build that cannot be placed: every setting whose default never
             // changed (no row in `psa::defaults`) holds at any build.
-            let changed_ever = |setting: &str| crate::psa::defaults::CHANGES.iter().any(|c| c.key == setting);
+            let changed_ever = |setting: &str| psa_sim::psa::defaults::CHANGES.iter().any(|c| c.key == setting);
             if let Some((setting, there, here)) = differences(&found, &expected)?
                 .into_iter()
                 .find(|(setting, _, _)| !changed_ever(setting))
@@ -461,7 +465,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
     if !folder.join(FINISHED_MARKER).exists() {
         return Ok(RunStatus::Unfinished);
     }
-    for name in ["records.csv", "champion.json", "run.json"] {
+    for name in [RunFiles::RECORDS, RunFiles::CHAMPION, RunFiles::SUMMARY] {
         if !folder.join(name).exists() {
             bail!(
                 "{}: finished run without {name}: the folder is damaged",
@@ -477,13 +481,13 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
 /// setting it lacks given the value the build that wrote it used (named
 /// by its `run.json`; see `psa::defaults`).
 pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
-    let path = folder.join("config.toml");
-    let text = crate::io::read_input(&path, "run configuration")?;
+    let path = RunFiles::in_dir(folder).config;
+    let text = psa_sim::io::read_input(&path, "run configuration")?;
     let damaged = || format!("{}: damaged configuration", path.display());
     let table: toml::Table = toml::from_str(&text).with_context(damaged)?;
     let mut doc = serde_json::to_value(&table).with_context(damaged)?;
     let placement = folder_placement(folder);
-    crate::psa::defaults::fill(&mut doc, "", &placement).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    psa_sim::psa::defaults::fill(&mut doc, "", &placement).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let table: toml::Table = serde_json::from_value(doc).with_context(damaged)?;
     RunConfig::default()
         .with_overrides(&toml::to_string(&table)?)
@@ -492,9 +496,9 @@ pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
 
 /// Where the build that wrote the run in `folder` stands in the table of
 /// defaults: by its `run.json`'s `build`.
-fn folder_placement(folder: &Path) -> crate::psa::defaults::Placement {
-    use crate::psa::defaults::Placement;
-    let build = crate::io::read_input_text(&folder.join("run.json"))
+fn folder_placement(folder: &Path) -> psa_sim::psa::defaults::Placement {
+    use psa_sim::psa::defaults::Placement;
+    let build = psa_sim::io::read_input_text(&RunFiles::in_dir(folder).summary)
         .ok()
         .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
         .and_then(|run| run.get("build").cloned());
@@ -506,7 +510,7 @@ fn folder_placement(folder: &Path) -> crate::psa::defaults::Placement {
 
 /// The build that wrote the run in `folder`, in words.
 fn folder_build(folder: &Path) -> String {
-    let build = crate::io::read_input_text(&folder.join("run.json"))
+    let build = psa_sim::io::read_input_text(&RunFiles::in_dir(folder).summary)
         .ok()
         .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
         .and_then(|run| run.get("build").cloned());
@@ -595,21 +599,22 @@ pub fn differences(a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, 
 fn check_finished_files(folder: &Path, spec: &GridSpec) -> Result<()> {
     let read = |name: &str| -> Result<String> {
         let path = folder.join(name);
-        crate::io::read_input(&path, "run file")
+        psa_sim::io::read_input(&path, "run file")
     };
     let damaged = |name: &str| format!("{}: damaged file", folder.join(name).display());
     serde_json::from_str::<super::robustness::Robustness>(&read(FINISHED_MARKER)?)
         .with_context(|| damaged(FINISHED_MARKER))?;
-    let summary: serde_json::Value = serde_json::from_str(&read("run.json")?).with_context(|| damaged("run.json"))?;
+    let summary: serde_json::Value =
+        serde_json::from_str(&read(RunFiles::SUMMARY)?).with_context(|| damaged(RunFiles::SUMMARY))?;
     if !summary.get("champion_fitness").is_some_and(|f| f.is_number()) {
-        bail!("{}: no champion_fitness", damaged("run.json"));
+        bail!("{}: no champion_fitness", damaged(RunFiles::SUMMARY));
     }
-    crate::psa::NetworkFile::load(&folder.join("champion.json"))?;
-    let rows = read("records.csv")?.lines().count();
+    psa_sim::psa::NetworkFile::load(&RunFiles::in_dir(folder).champion)?;
+    let rows = read(RunFiles::RECORDS)?.lines().count();
     if rows != spec.generations + 1 {
         bail!(
             "{}: {} rows, expected a header and {} generations",
-            damaged("records.csv"),
+            damaged(RunFiles::RECORDS),
             rows,
             spec.generations
         );

@@ -9,12 +9,12 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use rand::RngExt;
 
-use crate::evaluator::EvalPath;
 use crate::grid::{run_dir, GridSpec, RunKey, FINISHED_MARKER};
 use crate::ode_check::check_on_ode;
-use crate::psa::NetworkFile;
 use crate::robustness::{test_robustness, Robustness};
 use crate::{run_evolution, EvolveOutcome, RunFiles};
+use psa_sim::evaluator::EvalPath;
+use psa_sim::psa::NetworkFile;
 
 /// Stream key of the run seeds.
 const RUN_SEED: u64 = 201;
@@ -29,7 +29,7 @@ pub fn run_seed(key: &RunKey) -> u64 {
         .name()
         .bytes()
         .fold(0u64, |h, b| h.wrapping_mul(131).wrapping_add(b as u64));
-    crate::rng::stream(key.seed, &[RUN_SEED, config_key, key.task.number() as u64]).random::<u64>()
+    esp_neuroevolution::rng::stream(key.seed, &[RUN_SEED, config_key, key.task.number() as u64]).random::<u64>()
 }
 
 /// What happened to one run.
@@ -101,7 +101,7 @@ pub(crate) fn score_champion(
     key: &RunKey,
     seed: u64,
     path: &EvalPath,
-) -> Result<(crate::network::Network, crate::RunConfig, Robustness)> {
+) -> Result<(esp_neuroevolution::network::Network, crate::RunConfig, Robustness)> {
     // The run's own configuration (a grid an earlier build wrote is
     // re-scored under the defaults it was evolved with), with the grid's
     // rescoring laid over it.
@@ -112,7 +112,7 @@ pub(crate) fn score_champion(
             .with_context(|| format!("configuration {} with the grid's rescoring", key.config))?,
         None => run,
     };
-    let (_, champion) = NetworkFile::load(&folder.join("champion.json"))?;
+    let (_, champion) = NetworkFile::load(&RunFiles::in_dir(&folder).champion)?;
     let mut robustness = test_robustness(
         &champion,
         key.task,
@@ -129,5 +129,5 @@ pub(crate) fn score_champion(
 pub(crate) fn mark_finished(folder: &Path, robustness: &Robustness) -> Result<()> {
     let mut json = serde_json::to_string_pretty(robustness)?;
     json.push('\n');
-    crate::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())
+    psa_sim::io::write_atomic(&folder.join(FINISHED_MARKER), json.as_bytes())
 }

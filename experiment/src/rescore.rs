@@ -13,10 +13,11 @@ use super::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
 use super::grid_run::{mark_finished, run_seed, score_champion};
 use super::replicate::prepare;
 use super::shard::Shard;
-use crate::evaluator::EvalPath;
+use crate::RunFiles;
+use psa_sim::evaluator::EvalPath;
 
 /// The files of a run that re-scoring copies unchanged (its evolution).
-const EVOLUTION_FILES: [&str; 4] = ["config.toml", "records.csv", "champion.json", "run.json"];
+const EVOLUTION_FILES: [&str; 4] = RunFiles::NAMES;
 
 /// What [`rescore`] did.
 #[derive(Debug, Clone)]
@@ -158,7 +159,7 @@ pub fn rescore(source: &Path, out: &Path, spec: &GridSpec, threads: usize) -> Re
     let (todo, _) = prepare(out, spec, Shard::ALL, Judge::Read)?;
     let todo: Vec<RunKey> = todo.into_iter().filter(|k| finished.contains(k)).collect();
     let skipped = finished.len() - todo.len();
-    let pool = crate::ode::thread_pool(threads)?;
+    let pool = psa_sim::ode::thread_pool(threads)?;
     pool.install(|| {
         todo.par_iter()
             .with_max_len(1)
@@ -178,10 +179,10 @@ pub fn rescore(source: &Path, out: &Path, spec: &GridSpec, threads: usize) -> Re
 /// its robustness tests under `spec`'s scoring.
 fn rescore_run(source: &Path, out: &Path, spec: &GridSpec, key: &RunKey) -> Result<()> {
     let (from, to) = (run_dir(source, key), run_dir(out, key));
-    crate::io::create_output_dir(&to)?;
+    psa_sim::io::create_output_dir(&to)?;
     for name in EVOLUTION_FILES {
-        let text = crate::io::read_input(&from.join(name), "run file")?;
-        crate::io::write_atomic(&to.join(name), text.as_bytes())?;
+        let text = psa_sim::io::read_input(&from.join(name), "run file")?;
+        psa_sim::io::write_atomic(&to.join(name), text.as_bytes())?;
     }
     let (_, _, robustness) = score_champion(&to, spec, key, run_seed(key), &EvalPath::Fastest)
         .with_context(|| format!("re-scoring {}", from.display()))?;

@@ -9,9 +9,10 @@ use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::grid::{RunKey, FINISHED_MARKER};
-use crate::io::write_atomic;
-use crate::psa::Task;
 use crate::robustness::Robustness;
+use crate::RunFiles;
+use psa_sim::io::write_atomic;
+use psa_sim::psa::Task;
 
 /// What `run.json` holds: written by [`crate::run_evolution`] (and the ODE
 /// check), read by the report, by this one type.
@@ -19,13 +20,13 @@ use crate::robustness::Robustness;
 pub struct EvolveOutcome {
     /// The task.
     pub task: Task,
-    /// The seed (written as a string: see [`crate::io::u64_string`]).
-    #[serde(with = "crate::io::u64_string")]
+    /// The seed (written as a string: see [`psa_sim::io::u64_string`]).
+    #[serde(with = "psa_sim::io::u64_string")]
     pub seed: u64,
     /// A label for the configuration (the preset's name).
     pub label: String,
     /// The physics backend.
-    pub backend: crate::physics::BackendKind,
+    pub backend: psa_sim::physics::BackendKind,
     /// The champion's fitness (% of the theoretical maximum).
     pub champion_fitness: f64,
     /// The generation (cycle) it was found in.
@@ -39,7 +40,7 @@ pub struct EvolveOutcome {
     /// Hidden neurons of the champion.
     pub champion_hidden: usize,
     /// Tool version, git commit, libode version.
-    pub build: crate::provenance::BuildInfo,
+    pub build: psa_sim::provenance::BuildInfo,
     /// Start time (RFC 3339).
     pub started: String,
     /// End time (RFC 3339).
@@ -93,10 +94,10 @@ pub struct RunData {
 pub fn load_run(folder: &Path, key: &RunKey) -> Result<RunData> {
     let read = |name: &str| -> Result<(PathBuf, String)> {
         let path = folder.join(name);
-        let text = crate::io::read_input(&path, "run file")?;
+        let text = psa_sim::io::read_input(&path, "run file")?;
         Ok((path, text))
     };
-    let (path, text) = read("run.json")?;
+    let (path, text) = read(RunFiles::SUMMARY)?;
     let summary: EvolveOutcome =
         serde_json::from_str(&text).with_context(|| format!("{}: damaged file", path.display()))?;
     if summary.task != key.task || !summary.champion_fitness.is_finite() {
@@ -111,7 +112,7 @@ pub fn load_run(folder: &Path, key: &RunKey) -> Result<RunData> {
     let (path, text) = read(FINISHED_MARKER)?;
     let robustness: Robustness =
         serde_json::from_str(&text).with_context(|| format!("{}: damaged file", path.display()))?;
-    let (path, text) = read("records.csv")?;
+    let (path, text) = read(RunFiles::RECORDS)?;
     let records = parse_records(&text).with_context(|| format!("{}: damaged file", path.display()))?;
     Ok(RunData {
         key: *key,

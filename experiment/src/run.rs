@@ -6,12 +6,12 @@ use std::time::Instant;
 
 use super::{Algorithm, RunConfig};
 use crate::columns::{header, row, Column};
-use crate::evaluator::{EvalPath, PsaEvaluator};
-use crate::evolution::{Esp, GenerationRecord, HillClimb, LesionOutcome, RunResult};
-use crate::io::write_atomic;
-use crate::psa::{NetworkFile, Task};
 use crate::results::EvolveOutcome;
 use anyhow::{Context, Result};
+use esp_neuroevolution::{Esp, GenerationRecord, HillClimb, LesionOutcome, RunResult};
+use psa_sim::evaluator::{EvalPath, PsaEvaluator};
+use psa_sim::io::write_atomic;
+use psa_sim::psa::{NetworkFile, Task};
 
 /// The files of a run directory.
 #[derive(Debug, Clone)]
@@ -27,13 +27,24 @@ pub struct RunFiles {
 }
 
 impl RunFiles {
+    /// The name of [`RunFiles::config`].
+    pub const CONFIG: &'static str = "config.toml";
+    /// The name of [`RunFiles::records`].
+    pub const RECORDS: &'static str = "records.csv";
+    /// The name of [`RunFiles::champion`].
+    pub const CHAMPION: &'static str = "champion.json";
+    /// The name of [`RunFiles::summary`].
+    pub const SUMMARY: &'static str = "run.json";
+    /// Every file's name, in the order above.
+    pub const NAMES: [&'static str; 4] = [Self::CONFIG, Self::RECORDS, Self::CHAMPION, Self::SUMMARY];
+
     /// The files of the run directory `dir`.
     pub fn in_dir(dir: &Path) -> RunFiles {
         RunFiles {
-            config: dir.join("config.toml"),
-            records: dir.join("records.csv"),
-            champion: dir.join("champion.json"),
-            summary: dir.join("run.json"),
+            config: dir.join(Self::CONFIG),
+            records: dir.join(Self::RECORDS),
+            champion: dir.join(Self::CHAMPION),
+            summary: dir.join(Self::SUMMARY),
         }
     }
 }
@@ -127,7 +138,7 @@ struct LiveRecords {
 impl LiveRecords {
     fn create(path: &Path) -> LiveRecords {
         // Never through a link or into a FIFO or device (docs/limits.md).
-        if crate::io::check_output_file(path).is_err() {
+        if psa_sim::io::check_output_file(path).is_err() {
             return LiveRecords { file: None };
         }
         let file = std::fs::File::create(path).and_then(|mut f| {
@@ -194,14 +205,14 @@ impl RunStart {
     /// Checks `config`, makes `dir` and writes `config.toml` into it.
     pub fn new(config: &RunConfig, dir: &Path) -> Result<RunStart> {
         config.validate()?;
-        crate::io::create_output_dir(dir)?;
+        psa_sim::io::create_output_dir(dir)?;
         let files = RunFiles::in_dir(dir);
         write_atomic(&files.config, config.to_toml()?.as_bytes())?;
         let live = LiveRecords::create(&files.records);
         Ok(RunStart {
             files,
             live,
-            started: crate::provenance::now_rfc3339(),
+            started: psa_sim::provenance::now_rfc3339(),
             clock: Instant::now(),
         })
     }
@@ -247,7 +258,7 @@ impl RunStart {
             champion_hidden: champion.network.hidden(),
             build,
             started: self.started,
-            finished: crate::provenance::now_rfc3339(),
+            finished: psa_sim::provenance::now_rfc3339(),
             seconds,
             ode_check: None,
         };

@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use super::grid::run_dir;
 use crate::columns::{csv_field, header, row, Column};
 use crate::results::RunData;
+use crate::RunFiles;
 
 /// The file name, in the grid directory.
 pub const RUNS_CSV: &str = "runs.csv";
@@ -144,7 +145,7 @@ pub fn sweep_runs_csv(keys: &[String], variants: &[VariantRuns]) -> Result<Strin
     let _ = writeln!(csv, ",{}", header(&RUN_COLUMNS));
     for variant in variants {
         for run in variant.runs {
-            let path = run_dir(variant.dir, &run.key).join("config.toml");
+            let path = RunFiles::in_dir(&run_dir(variant.dir, &run.key)).config;
             let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
             let config: toml::Table = text
                 .parse()

@@ -4,13 +4,13 @@ use std::path::{Path, PathBuf};
 
 use super::*;
 use crate::grid::{GridPreset, GridSpec, FINISHED_MARKER};
-use crate::network::Network;
-use crate::physics::BackendKind;
-use crate::psa::NetworkFile;
 use crate::results::{parse_records, GenerationRow};
 use crate::robustness::{Robustness, TrialSummary};
-use crate::Preset;
 use crate::BASELINE;
+use crate::{Preset, RunFiles};
+use esp_neuroevolution::network::Network;
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::NetworkFile;
 
 const MAX_CREDIT: GridConfig = GridConfig::Preset(Preset::MaxCredit);
 
@@ -48,14 +48,14 @@ fn write_run(dir: &Path, spec: &GridSpec, key: &RunKey) -> PathBuf {
     let folder = run_dir(dir, key);
     std::fs::create_dir_all(&folder).unwrap();
     let config = spec.run_config(key.config).unwrap();
-    std::fs::write(folder.join("config.toml"), config.to_toml().unwrap()).unwrap();
+    std::fs::write(RunFiles::in_dir(&folder).config, config.to_toml().unwrap()).unwrap();
     let (champion, noise, random, bursts) = numbers(key);
     let mut csv = String::from("generation,min,mean,max,best,champion,evaluations,subpops,burst,bursts,lesion\n");
     for g in 1..=spec.generations {
         let f = champion * g as f64 / spec.generations as f64;
         csv.push_str(&format!("{g},0,{},{f},{f},{f},{},5,false,0,\n", f / 2.0, 400 * g));
     }
-    std::fs::write(folder.join("records.csv"), csv).unwrap();
+    std::fs::write(RunFiles::in_dir(&folder).records, csv).unwrap();
     let network = Network::from_neurons(5, 4, &[vec![0.25; 9], vec![-0.5; 9]]).unwrap();
     NetworkFile::new(
         &network,
@@ -64,7 +64,7 @@ fn write_run(dir: &Path, spec: &GridSpec, key: &RunKey) -> PathBuf {
         &crate::build_info(),
         serde_json::Map::new(),
     )
-    .save(&folder.join("champion.json"))
+    .save(&RunFiles::in_dir(&folder).champion)
     .unwrap();
     let run = serde_json::json!({
         "task": key.task, "seed": 1234, "label": key.config.name(), "backend": "native",
@@ -73,7 +73,11 @@ fn write_run(dir: &Path, spec: &GridSpec, key: &RunKey) -> PathBuf {
         "build": {"tool_version": "0.1.0", "git_commit": "abc123", "libode_version": "0.16.2"},
         "started": "2026-01-01T00:00:00Z", "finished": "2026-01-01T00:00:01Z", "seconds": 1.5
     });
-    std::fs::write(folder.join("run.json"), serde_json::to_string_pretty(&run).unwrap()).unwrap();
+    std::fs::write(
+        RunFiles::in_dir(&folder).summary,
+        serde_json::to_string_pretty(&run).unwrap(),
+    )
+    .unwrap();
     let robustness = Robustness {
         trials: spec.robustness_trials,
         input_noise_sd: 0.05,
@@ -291,19 +295,19 @@ fn damaged_and_foreign_folders_are_reported_not_counted() {
         seed,
     };
     // A truncated run.json.
-    let truncated = run_dir(dir.path(), &key(BASELINE, 1)).join("run.json");
+    let truncated = run_dir(dir.path(), &key(BASELINE, 1)).join(RunFiles::SUMMARY);
     let text = std::fs::read_to_string(&truncated).unwrap();
     std::fs::write(&truncated, &text[..text.len() / 2]).unwrap();
     // A folder holding another configuration.
     let foreign = run_dir(dir.path(), &key(BASELINE, 2));
-    let config = std::fs::read_to_string(foreign.join("config.toml")).unwrap();
+    let config = std::fs::read_to_string(RunFiles::in_dir(&foreign).config).unwrap();
     std::fs::write(
-        foreign.join("config.toml"),
+        RunFiles::in_dir(&foreign).config,
         config.replace("subpop_size = 40", "subpop_size = 20"),
     )
     .unwrap();
     // Garbage in records.csv (right number of lines).
-    let garbage = run_dir(dir.path(), &key(MAX_CREDIT, 1)).join("records.csv");
+    let garbage = run_dir(dir.path(), &key(MAX_CREDIT, 1)).join(RunFiles::RECORDS);
     std::fs::write(&garbage, "generation,min\nx,y\n1\n2\n3\n").unwrap();
 
     let outcome = write_report(dir.path(), ReportFormat::Md).unwrap();
