@@ -32,7 +32,10 @@ impl Task {
 
     /// Whether the paper has a random-initialisation variant (tasks 1 and 3).
     pub fn has_random_init(self) -> bool {
-        self != Task::Turn
+        match self {
+            Task::StopRotation | Task::StopAtPosition => true,
+            Task::Turn => false,
+        }
     }
 
     /// Whether the paper ran this task (its tables have a column for it): a
