@@ -1,9 +1,9 @@
 //! Many ODE worlds stepped at once on rayon threads, each world built on the
 //! thread that steps it, give bit-identical results to stepping them one by one.
 
-use psa_esp::ode::thread_pool;
-use psa_esp::physics::{create_backend, random_thrust_sequence, trajectory, BackendKind, BodyState, StepSettings};
-use psa_esp::psa::BodySettings;
+use psa_sim::ode::thread_pool;
+use psa_sim::physics::{create_backend, random_thrust_sequence, trajectory, BackendKind, BodyState, StepSettings};
+use psa_sim::psa::BodySettings;
 use rayon::prelude::*;
 
 fn run(kind: BackendKind, index: u64) -> Vec<BodyState> {

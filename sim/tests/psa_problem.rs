@@ -2,15 +2,15 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use psa_esp::network::Network;
-use psa_esp::numeric::NoiseSource;
-use psa_esp::physics::{BackendKind, BodyState};
-use psa_esp::psa::fitness::StepError;
-use psa_esp::psa::{
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::stream;
+use psa_sim::numeric::NoiseSource;
+use psa_sim::physics::{BackendKind, BodyState};
+use psa_sim::psa::fitness::StepError;
+use psa_sim::psa::{
     FitnessKind, FitnessSettings, NoiseSettings, PsaSettings, SensorSettings, Target, Task, TaskSettings, TrialRecord,
     TrialRunner,
 };
-use psa_esp::rng::stream;
 use rand::RngExt;
 
 /// A 7-1-4 network whose every output is exactly `u` (0 or 1): the hidden
@@ -398,17 +398,17 @@ fn inputs_are_relative_to_the_target_scaled_and_wrapped() {
 }
 
 mod per_task {
-    use psa_esp::psa::{FitnessKind, Scoring, Task, TaskOverrides, TrialRunner};
+    use psa_sim::psa::{FitnessKind, Scoring, Task, TaskOverrides, TrialRunner};
 
     #[test]
     fn a_task_flies_its_own_steps_and_fitness_and_is_scored_with_its_scoring() {
-        let mut s = psa_esp::psa::PsaSettings {
+        let mut s = psa_sim::psa::PsaSettings {
             task3: TaskOverrides {
                 steps: Some(2000),
                 fitness: Some(FitnessKind::Original),
                 scoring: None,
             },
-            ..psa_esp::psa::PsaSettings::default()
+            ..psa_sim::psa::PsaSettings::default()
         };
         s.fitness.scoring = Scoring::Original;
         let task3 = s.for_task(Task::StopAtPosition).unwrap();

@@ -1,10 +1,10 @@
 //! Backends against each other on seeded random thrust sequences.
 
-use psa_esp::physics::{
+use psa_sim::physics::{
     create_backend, crosscheck, random_thrust_sequence, tolerance, trajectory, BackendKind, BodyState, Deviation,
     PlaneConstraint, StartQuaternion, StepSettings, Stepper,
 };
-use psa_esp::psa::BodySettings;
+use psa_sim::psa::BodySettings;
 
 #[test]
 fn native_matches_ode_within_1e_9_on_100_random_sequences() {

@@ -2,8 +2,8 @@
 
 use std::f64::consts::PI;
 
-use psa_esp::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, StepSettings};
-use psa_esp::psa::BodySettings;
+use psa_sim::physics::{create_backend, wrap_angle, BackendKind, BodyState, PhysicsBackend, StepSettings};
+use psa_sim::psa::BodySettings;
 
 fn backend(kind: BackendKind) -> Box<dyn PhysicsBackend> {
     let model = BodySettings::default().model().unwrap();
