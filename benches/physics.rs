@@ -6,8 +6,8 @@
 //! in one run and prints a table.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use psa_esp::physics::{create_backend, BackendKind, BodyState, StepSettings};
-use psa_esp::psa::BodySettings;
+use psa_sim::physics::{create_backend, BackendKind, BodyState, StepSettings};
+use psa_sim::psa::BodySettings;
 
 fn physics_step(c: &mut Criterion) {
     let model = BodySettings::default().model().expect("default body is valid");
@@ -33,7 +33,7 @@ fn physics_step(c: &mut Criterion) {
 
 /// 500 steps of our ODE path (`step` + `planar_state`) and of the bare ODE calls.
 fn ode_path(c: &mut Criterion) {
-    use psa_esp::physics::{random_thrust_sequence, OdeBackend, PhysicsBackend};
+    use psa_sim::physics::{random_thrust_sequence, OdeBackend, PhysicsBackend};
     let model = BodySettings::default().model().expect("default body is valid");
     let thrust = random_thrust_sequence(1, 0, 500, model.thrusters.len());
     let mut group = c.benchmark_group("ode_path_500_steps");
@@ -63,11 +63,11 @@ fn ode_path(c: &mut Criterion) {
 /// One PSA network evaluation (a 500-step trial of task 1) per path; the
 /// batched path evaluates 32 networks per iteration, reported per network.
 fn psa_evaluation(c: &mut Criterion) {
-    use psa_esp::evolution::operators::random_genes;
-    use psa_esp::network::Network;
-    use psa_esp::numeric::SimdLevel;
-    use psa_esp::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
-    let mut rng = psa_esp::rng::stream(1, &[]);
+    use esp_neuroevolution::network::Network;
+    use esp_neuroevolution::operators::random_genes;
+    use psa_sim::numeric::SimdLevel;
+    use psa_sim::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
+    let mut rng = esp_neuroevolution::rng::stream(1, &[]);
     let networks: Vec<Network> = (0..32)
         .map(|_| Network::from_genes(7, 4, random_genes(&mut rng, 55, 6.0)).expect("valid network"))
         .collect();
@@ -88,7 +88,7 @@ fn psa_evaluation(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter(|| {
                 runner
-                    .evaluate(network, &mut psa_esp::rng::stream(0, &[]))
+                    .evaluate(network, &mut esp_neuroevolution::rng::stream(0, &[]))
                     .expect("evaluate")
             })
         });
@@ -104,7 +104,9 @@ fn psa_evaluation(c: &mut Criterion) {
             .with_level(level);
         group.bench_function(format!("native batched {level} (32 networks)"), |b| {
             b.iter(|| {
-                let mut rngs: Vec<_> = (0..networks.len()).map(|_| psa_esp::rng::stream(0, &[])).collect();
+                let mut rngs: Vec<_> = (0..networks.len())
+                    .map(|_| esp_neuroevolution::rng::stream(0, &[]))
+                    .collect();
                 runner
                     .evaluate(&networks[..], 0..networks.len(), &mut rngs)
                     .expect("evaluate")
@@ -118,7 +120,7 @@ fn psa_evaluation(c: &mut Criterion) {
 /// CPU's best SIMD level; reported per value.
 fn logistic_function(c: &mut Criterion) {
     use psa_esp::cli::bench::{logistic_arguments, logistic_rounds, LOGISTIC_BLOCKS};
-    use psa_esp::psa::batch::LANES;
+    use psa_sim::psa::batch::LANES;
     let mut values = logistic_arguments(LOGISTIC_BLOCKS);
     let mut group = c.benchmark_group("logistic_function");
     group.throughput(criterion::Throughput::Elements((LOGISTIC_BLOCKS * LANES) as u64));

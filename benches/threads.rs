@@ -7,11 +7,11 @@
 //! prints it, with the machine.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use esp_neuroevolution::evaluate_all;
 use psa_esp::cli::bench::{machine, EvaluationPath};
 use psa_esp::cli::bench_networks::random_networks;
 use psa_esp::cli::bench_runs::{evolve_workload, replicate_workload};
-use psa_esp::evolution::evaluate_all;
-use psa_esp::ode::thread_pool;
+use psa_sim::ode::thread_pool;
 
 /// Networks per timed iteration: two full blocks of the batched path per thread.
 const NETWORKS: u64 = 128;

@@ -1,8 +1,8 @@
 //! Values ODE would abort on are refused with an error naming them.
 
-use psa_esp::ode::{Mass, World};
-use psa_esp::physics::{create_backend, BackendKind, BodyState, StepSettings};
-use psa_esp::psa::BodySettings;
+use psa_sim::ode::{Mass, World};
+use psa_sim::physics::{create_backend, BackendKind, BodyState, StepSettings};
+use psa_sim::psa::BodySettings;
 
 fn err_text<T>(result: Result<T, impl std::fmt::Display>) -> String {
     match result {
@@ -173,7 +173,7 @@ fn the_most_violent_body_the_ranges_allow_never_reaches_the_guard() {
         heading: 0.0,
     })
     .unwrap();
-    for _ in 0..psa_esp::psa::limits::MAX_STEPS {
+    for _ in 0..psa_sim::psa::limits::MAX_STEPS {
         b.step(&[1.0, 1.0, 0.0, 0.0]).unwrap();
     }
     assert!(b.state().omega > 1e14, "it did spin up: {:?}", b.state());
@@ -181,8 +181,8 @@ fn the_most_violent_body_the_ranges_allow_never_reaches_the_guard() {
 
 #[test]
 fn every_range_of_the_limits_table_is_enforced_from_a_configuration() {
-    use psa_esp::experiment::RunConfig;
-    use psa_esp::psa::limits::LIMITS;
+    use psa_experiment::RunConfig;
+    use psa_sim::psa::limits::LIMITS;
     let defaults = toml::Table::try_from(RunConfig::default()).unwrap();
     let problem = defaults["problem"].as_table().unwrap();
     let mut checked = 0;

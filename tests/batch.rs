@@ -6,15 +6,15 @@
 
 mod kernel_cases;
 
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::stream;
 use kernel_cases::{
     assert_bit_identical, native, noisy_settings, original_fitness_settings, random_network, scalar_fitness, streams,
 };
-use psa_esp::network::Network;
-use psa_esp::numeric::{Exponential, SimdLevel};
-use psa_esp::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
-use psa_esp::psa::cuda::{evaluate_with, fly_on_host};
-use psa_esp::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
-use psa_esp::rng::stream;
+use psa_sim::numeric::{Exponential, SimdLevel};
+use psa_sim::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
+use psa_sim::psa::cuda::{evaluate_with, fly_on_host};
+use psa_sim::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
 
 /// Fitness of networks `seeds` by the scalar path and by the batched path on `level`.
 fn both_paths(
@@ -86,7 +86,7 @@ fn batched_fitness_equals_the_scalar_path_under_every_reading_of_the_inputs_and_
 /// make the fast one's difference 10. So the accurate exponential gives
 /// that thruster a command of about 1/2, the fast one about 0 or 1.
 fn networks_that_tell_the_exponentials_apart() -> Vec<Network> {
-    use psa_esp::numeric::sigmoid_with;
+    use psa_sim::numeric::sigmoid_with;
     let mut networks = Vec::new();
     for (i, x) in [0.5, 1.25, -0.75, 2.0, -1.5].into_iter().enumerate() {
         let (accurate, fast) = (
@@ -233,15 +233,15 @@ fn the_batched_path_refuses_other_backends_and_bad_networks() {
 
 #[test]
 fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
-    use psa_esp::evaluator::{EvalPath, PsaEvaluator};
-    use psa_esp::evolution::{Esp, EspSettings};
+    use esp_neuroevolution::{Esp, EspSettings};
+    use psa_sim::evaluator::{EvalPath, PsaEvaluator};
     let settings = native(PsaSettings::default());
     let esp = Esp::new(
         EspSettings {
             subpop_size: 12,
             generations: 12,
             stagnation: 3,
-            ..psa_esp::experiment::paper_esp_settings()
+            ..psa_experiment::paper_esp_settings()
         },
         7,
     )
@@ -249,7 +249,7 @@ fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
     let run = |level: Option<SimdLevel>, threads: usize| {
         let path = level.map_or(EvalPath::Scalar, EvalPath::Simd);
         let evaluator = PsaEvaluator::new(settings.clone(), Task::StopAtPosition, &path).unwrap();
-        let pool = psa_esp::ode::thread_pool(threads).unwrap();
+        let pool = psa_sim::ode::thread_pool(threads).unwrap();
         let result = pool.install(|| esp.run(&evaluator, |_| {})).unwrap();
         (
             result.records,
@@ -271,5 +271,5 @@ fn an_esp_run_on_native_is_the_same_on_every_path_and_thread_count() {
 /// Fitness of networks `seeds` by the `cuda` path's kernel built for the host.
 #[test]
 fn the_cuda_kernel_built_for_the_host_computes_the_scalar_paths_bits() {
-    kernel_cases::assert_kernel_gives_the_scalar_paths_bits(psa_esp::psa::cuda::fly_on_host);
+    kernel_cases::assert_kernel_gives_the_scalar_paths_bits(psa_sim::psa::cuda::fly_on_host);
 }

@@ -21,7 +21,7 @@ fn stderr(o: &Output) -> String {
 fn version_names_the_commit_and_the_libode_version() {
     let o = psa_esp(&["--version"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let info = psa_esp::experiment::build_info();
+    let info = psa_experiment::build_info();
     assert_eq!(
         stdout(&o).trim(),
         format!(
@@ -148,7 +148,7 @@ fn bench_prints_ns_per_step_for_every_backend_and_the_logistic_share() {
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let rows = report["physics_step"].as_array().unwrap();
-    assert_eq!(rows.len(), psa_esp::physics::BackendKind::available().len());
+    assert_eq!(rows.len(), psa_sim::physics::BackendKind::available().len());
     assert!(rows.iter().all(|r| r["median_ns_per_step"].as_f64().unwrap() > 0.0));
     let logistic = &report["logistic_function"];
     assert!(logistic["ns_per_value"].as_f64().unwrap() > 0.0, "{logistic}");
@@ -173,13 +173,13 @@ fn bench_prints_ns_per_step_for_every_backend_and_the_logistic_share() {
 /// A hand-made 7-3-4 spin damper: neuron 0 fires thrusters 2 and 3
 /// (clockwise torque) when omega > 0, neuron 1 fires 0 and 1 when omega < 0,
 /// neuron 2 is a constant that keeps every output near 0 otherwise.
-fn spin_damper() -> psa_esp::network::Network {
+fn spin_damper() -> esp_neuroevolution::network::Network {
     let omega = |w: f64, bias: f64, out: [f64; 4]| {
         let mut genes = vec![0.0, 0.0, 0.0, 0.0, 0.0, w, bias];
         genes.extend(out);
         genes
     };
-    psa_esp::network::Network::from_neurons(
+    esp_neuroevolution::network::Network::from_neurons(
         7,
         4,
         &[
@@ -193,7 +193,7 @@ fn spin_damper() -> psa_esp::network::Network {
 
 #[test]
 fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
-    use psa_esp::psa::{NetworkFile, PsaSettings, Task};
+    use psa_sim::psa::{NetworkFile, PsaSettings, Task};
     let dir = tempfile::tempdir().unwrap();
     let net_path = dir.path().join("damper.json");
     // The damper is made for task 1's earlier start spin of 1 rad/s (at the
@@ -205,7 +205,7 @@ fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
         &spin_damper(),
         Task::StopRotation,
         &model,
-        &psa_esp::experiment::build_info(),
+        &psa_experiment::build_info(),
         serde_json::Map::new(),
     )
     .save(&net_path)

@@ -4,15 +4,15 @@
 use std::path::Path;
 use std::process::Command;
 
-use psa_esp::evolution::{Esp, EspSettings, FnEvaluator, HillClimb, HillClimbSettings};
-use psa_esp::experiment::{Preset, RunConfig};
-use psa_esp::network::Network;
-use psa_esp::psa::{NetworkFile, PsaSettings, TrialRunner};
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::{Esp, EspSettings, FnEvaluator, HillClimb, HillClimbSettings};
+use psa_experiment::{Preset, RunConfig};
+use psa_sim::psa::{NetworkFile, PsaSettings, TrialRunner};
 
 /// XOR with a 3-H-1 network (inputs x1, x2, bias): fitness 4 minus the
 /// summed squared error over the four cases, so 4 is perfect.
-fn xor() -> impl psa_esp::evolution::Evaluator<Worker = ()> {
-    FnEvaluator::new(3, 1, |net: &Network, _: &mut psa_esp::rng::Stream| {
+fn xor() -> impl esp_neuroevolution::Evaluator<Worker = ()> {
+    FnEvaluator::new(3, 1, |net: &Network, _: &mut esp_neuroevolution::rng::Stream| {
         let mut out = [0.0];
         let mut error = 0.0;
         for (a, b) in [(0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)] {
@@ -201,7 +201,9 @@ fn evolve_writes_a_champion_that_replays_to_its_recorded_fitness() {
             .with_overrides(&std::fs::read_to_string(out.join("config.toml")).unwrap())
             .unwrap();
         let mut runner = TrialRunner::new(&resolved.problem, file.task).unwrap();
-        let fitness = runner.evaluate(&network, &mut psa_esp::rng::stream(0, &[])).unwrap();
+        let fitness = runner
+            .evaluate(&network, &mut esp_neuroevolution::rng::stream(0, &[]))
+            .unwrap();
         assert_eq!(fitness, summary["champion_fitness"].as_f64().unwrap(), "{preset}");
         let records = std::fs::read_to_string(out.join("records.csv")).unwrap();
         assert_eq!(records.lines().count(), 9, "header + 8 generations");

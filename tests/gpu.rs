@@ -24,7 +24,7 @@ use libtest_mimic::{Arguments, Failed, Trial};
 /// Set (as CI does), the NVRTC test runs, and fails, where NVRTC is missing
 /// instead of being ignored.
 const REQUIRE_NVRTC: &str = "PSA_ESP_REQUIRE_NVRTC";
-use psa_esp::psa::cuda::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME};
+use psa_sim::psa::cuda::{compile_for_check, CudaTrials, CudaUnavailable, KERNEL_NAME};
 
 fn nvrtc_compiles_the_trial_kernel() -> Result<(), Failed> {
     let ptx = compile_for_check().map_err(|e| e.to_string())?;

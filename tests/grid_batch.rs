@@ -7,8 +7,8 @@ use std::collections::BTreeSet;
 use std::process::{Command, Stdio};
 
 use common::{assert_same_runs, finished_lines, psa_esp, tiny_grid};
-use psa_esp::experiment::grid::GridSpec;
-use psa_esp::experiment::grid_run::run_seed;
+use psa_experiment::grid::GridSpec;
+use psa_experiment::grid_run::run_seed;
 
 fn args(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()
@@ -221,7 +221,7 @@ fn runs_csv_and_the_json_files_keep_every_seed_exact() {
         assert_eq!(row[col("task")], key.task.to_string());
         assert_eq!(row[col("run_seed")], seed.to_string());
         assert_eq!(row[col("backend")], "native");
-        let folder = psa_esp::experiment::grid::run_dir(&dir, &key);
+        let folder = psa_experiment::grid::run_dir(&dir, &key);
         let summary: serde_json::Value =
             serde_json::from_slice(&std::fs::read(folder.join("run.json")).unwrap()).unwrap();
         assert_eq!(summary["seed"], serde_json::Value::String(seed.to_string()));
@@ -245,7 +245,7 @@ fn runs_csv_and_the_json_files_keep_every_seed_exact() {
 
     // The seed read back from run.json repeats the run with `evolve`.
     let key = spec.runs()[0];
-    let folder = psa_esp::experiment::grid::run_dir(&dir, &key);
+    let folder = psa_experiment::grid::run_dir(&dir, &key);
     let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(folder.join("run.json")).unwrap()).unwrap();
     let seed = summary["seed"].as_str().unwrap();
     let again = tmp.path().join("again");

@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use psa_esp::network::Network;
-use psa_esp::psa::{NetworkFile, PsaSettings, SensorSettings, Task};
+use esp_neuroevolution::network::Network;
+use psa_sim::psa::{NetworkFile, PsaSettings, SensorSettings, Task};
 
 /// The most one row may take; each takes well under a second.
 const TIME_LIMIT: Duration = Duration::from_secs(60);
@@ -107,7 +107,7 @@ impl Fixtures {
         make_fifo(&fifo_grid.join("grid.json"));
         let huge_seeds_grid = dir.path().join("huge-grid");
         std::fs::create_dir(&huge_seeds_grid).unwrap();
-        let grid = psa_esp::experiment::grid::GridSpec::from_preset(psa_esp::experiment::grid::GridPreset::Quick);
+        let grid = psa_experiment::grid::GridSpec::from_preset(psa_experiment::grid::GridPreset::Quick);
         let mut json = serde_json::to_value(&grid).unwrap();
         json["seeds"] = serde_json::json!(1_000_000_000_000_000_000u64);
         std::fs::write(huge_seeds_grid.join("grid.json"), json.to_string()).unwrap();
@@ -178,7 +178,7 @@ fn save_network(path: &Path, scaling: SensorSettings) {
         &network,
         Task::StopRotation,
         &problem,
-        &psa_esp::experiment::build_info(),
+        &psa_experiment::build_info(),
         serde_json::Map::new(),
     )
     .save(path)

@@ -6,10 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use psa_esp::network::Network;
-use psa_esp::physics::BackendKind;
-use psa_esp::psa::{PsaSettings, Task, TrialRunner};
-use psa_esp::rng::stream;
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::stream;
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::{PsaSettings, Task, TrialRunner};
 
 fn psa_esp(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_psa-esp"))

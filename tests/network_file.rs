@@ -1,12 +1,12 @@
 //! Network files: exact round trips, and a clear error for each kind of malformed file.
 
-use psa_esp::network::Network;
-use psa_esp::numeric::Exponential;
-use psa_esp::psa::{NetworkFile, PsaSettings, Task};
+use esp_neuroevolution::network::Network;
+use psa_sim::numeric::Exponential;
+use psa_sim::psa::{NetworkFile, PsaSettings, Task};
 use rand::RngExt;
 
 fn sample_network() -> Network {
-    let mut rng = psa_esp::rng::stream(5, &[]);
+    let mut rng = esp_neuroevolution::rng::stream(5, &[]);
     // Awkward values on purpose: they must survive the trip bit for bit.
     let mut genes: Vec<f64> = (0..5 * 11).map(|_| rng.random_range(-6.0..6.0)).collect();
     genes[0] = 0.1 + 0.2;
@@ -28,7 +28,7 @@ fn save_and_load_round_trip_exactly() {
         &net,
         Task::StopAtPosition,
         &PsaSettings::default(),
-        &psa_esp::experiment::build_info(),
+        &psa_experiment::build_info(),
         extra,
     );
     file.save(&path).unwrap();
@@ -56,7 +56,7 @@ fn valid_json() -> serde_json::Value {
         &sample_network(),
         Task::Turn,
         &PsaSettings::default(),
-        &psa_esp::experiment::build_info(),
+        &psa_experiment::build_info(),
         serde_json::Map::new(),
     );
     serde_json::to_value(&file).unwrap()
@@ -65,7 +65,7 @@ fn valid_json() -> serde_json::Value {
 /// Makes `file` one of the build before commit `changed` (a file lacking
 /// a setting gets the value of the build that wrote it: `psa::defaults`).
 fn as_written_before(file: &mut serde_json::Value, changed: &str) {
-    let line = psa_esp::psa::defaults::BUILDS
+    let line = psa_sim::psa::defaults::BUILDS
         .lines()
         .find(|l| l.starts_with(changed))
         .unwrap();
@@ -95,7 +95,7 @@ fn files_from_before_the_exponential_setting_load_with_the_accurate_one() {
 
 #[test]
 fn files_from_before_the_readings_of_the_fitness_load_scored_on_their_evolution_fitness_from_the_true_state() {
-    use psa_esp::psa::{FitnessState, Scoring};
+    use psa_sim::psa::{FitnessState, Scoring};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("net.json");
     let mut old = valid_json();

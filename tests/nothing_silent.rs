@@ -10,12 +10,12 @@ use std::process::{Command, Output, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use psa_esp::experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
-use psa_esp::experiment::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_NAME};
-use psa_esp::network::Network;
-use psa_esp::physics::{BackendKind, StartQuaternion};
-use psa_esp::psa::defaults::{value_at, Placement, BUILDS, CHANGES};
-use psa_esp::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};
+use esp_neuroevolution::network::Network;
+use psa_experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
+use psa_experiment::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_NAME};
+use psa_sim::physics::{BackendKind, StartQuaternion};
+use psa_sim::psa::defaults::{value_at, Placement, BUILDS, CHANGES};
+use psa_sim::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};
 
 use common::psa_esp;
 
@@ -216,7 +216,7 @@ fn network_json(problem: &PsaSettings) -> serde_json::Value {
         &network,
         Task::StopRotation,
         problem,
-        &psa_esp::experiment::build_info(),
+        &psa_experiment::build_info(),
         serde_json::Map::new(),
     );
     serde_json::to_value(&file).unwrap()
@@ -644,7 +644,7 @@ fn what_killed_processes_left_is_cleared_when_the_grid_is_resumed_or_reported() 
     let grid = copy_of_grid(dir.path());
     let folder = run_folder(&grid);
     let expected = names_in(&folder);
-    let host = psa_esp::provenance::host_name();
+    let host = psa_sim::provenance::host_name();
     let dead = dead_pid();
     // A killed lockstep grid's claim on a finished run.
     let claim = serde_json::json!({

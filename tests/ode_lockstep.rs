@@ -5,14 +5,14 @@
 
 mod kernel_cases;
 
+use esp_neuroevolution::network::Network;
 use kernel_cases::{random_network, streams};
-use psa_esp::network::Network;
-use psa_esp::physics::{
+use psa_sim::physics::{
     random_thrust_sequence, BodyState, OdeBackend, OdeFleet, PhysicsBackend, PlanarState, PlaneConstraint,
     StepSettings, Stepper,
 };
-use psa_esp::psa::ode_lockstep::ODE_LOCKSTEP;
-use psa_esp::psa::{BodySettings, NoiseSettings, OdeLockstepRunner, PsaSettings, Task, TrialRunner};
+use psa_sim::psa::ode_lockstep::ODE_LOCKSTEP;
+use psa_sim::psa::{BodySettings, NoiseSettings, OdeLockstepRunner, PsaSettings, Task, TrialRunner};
 
 fn bits(values: &[f64]) -> Vec<u64> {
     values.iter().map(|v| v.to_bits()).collect()
@@ -107,7 +107,7 @@ fn lockstep_fitness_equals_one_world_per_network_under_every_reading_of_the_inpu
     for (what, settings) in kernel_cases::reading_settings() {
         for task in Task::ALL {
             let settings = PsaSettings {
-                backend: psa_esp::physics::BackendKind::Ode,
+                backend: psa_sim::physics::BackendKind::Ode,
                 random_init: settings.random_init && task.has_random_init(),
                 steps: 200,
                 ..settings.clone()
@@ -242,8 +242,8 @@ fn a_fleet_checks_every_command_and_state_before_calling_ode() {
 
 #[test]
 fn an_esp_run_on_ode_is_the_same_in_lockstep_and_one_world_per_network_on_any_thread_count() {
-    use psa_esp::evaluator::{EvalPath, PsaEvaluator};
-    use psa_esp::evolution::{Esp, EspSettings};
+    use esp_neuroevolution::{Esp, EspSettings};
+    use psa_sim::evaluator::{EvalPath, PsaEvaluator};
     let settings = PsaSettings {
         steps: 150,
         ..PsaSettings::default()
@@ -253,7 +253,7 @@ fn an_esp_run_on_ode_is_the_same_in_lockstep_and_one_world_per_network_on_any_th
             subpop_size: 8,
             generations: 6,
             stagnation: 2,
-            ..psa_esp::experiment::paper_esp_settings()
+            ..psa_experiment::paper_esp_settings()
         },
         11,
     )
@@ -265,7 +265,7 @@ fn an_esp_run_on_ode_is_the_same_in_lockstep_and_one_world_per_network_on_any_th
             EvalPath::Scalar
         };
         let evaluator = PsaEvaluator::new(settings.clone(), Task::StopAtPosition, &path).unwrap();
-        let pool = psa_esp::ode::thread_pool(threads).unwrap();
+        let pool = psa_sim::ode::thread_pool(threads).unwrap();
         let result = pool.install(|| esp.run(&evaluator, |_| {})).unwrap();
         (
             result.records,

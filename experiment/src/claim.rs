@@ -23,7 +23,7 @@ pub const DEFAULT_CLAIM_TIMEOUT: Duration = Duration::from_secs(48 * 3600);
 /// What `claim.json` holds.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ClaimRecord {
-    /// The claiming host ([`crate::provenance::host_name`]).
+    /// The claiming host ([`psa_sim::provenance::host_name`]).
     pub host: String,
     /// Its process id.
     pub pid: u32,
@@ -42,10 +42,10 @@ impl ClaimRecord {
     fn mine() -> ClaimRecord {
         let pid = std::process::id();
         ClaimRecord {
-            host: crate::provenance::host_name(),
+            host: psa_sim::provenance::host_name(),
             pid,
             process_start: process_start(pid),
-            started: crate::provenance::now_rfc3339(),
+            started: psa_sim::provenance::now_rfc3339(),
             started_unix: unix_now(),
         }
     }
@@ -60,7 +60,7 @@ impl ClaimRecord {
                 timeout.as_secs()
             ));
         }
-        if self.host == crate::provenance::host_name() && !process_alive(self.pid, self.process_start) {
+        if self.host == psa_sim::provenance::host_name() && !process_alive(self.pid, self.process_start) {
             return Some(format!("process {} on this host is gone", self.pid));
         }
         None
@@ -101,14 +101,14 @@ pub enum Attempt {
 /// Claims the run in `folder` (created if need be), taking over a claim
 /// whose process is gone or that is older than `timeout`.
 pub fn claim(folder: &Path, timeout: Duration) -> Result<Attempt> {
-    crate::io::create_output_dir(folder)?;
+    psa_sim::io::create_output_dir(folder)?;
     let path = folder.join(CLAIM_FILE);
     // Each pass either claims, finds a live claim, or clears a stale one;
     // only racing processes make it go round more than twice.
     for _ in 0..100 {
         let mut text = serde_json::to_string_pretty(&ClaimRecord::mine())?;
         text.push('\n');
-        if crate::io::create_new_atomic(&path, text.as_bytes())? {
+        if psa_sim::io::create_new_atomic(&path, text.as_bytes())? {
             return Ok(Attempt::Claimed(Claim { path, text }));
         }
         let existing = match std::fs::read_to_string(&path) {
@@ -140,7 +140,7 @@ pub fn claim(folder: &Path, timeout: Duration) -> Result<Attempt> {
 /// finished run holds only its documented files. A live claim is left.
 pub fn clear_stale(folder: &Path, timeout: Duration) -> Result<()> {
     let path = folder.join(CLAIM_FILE);
-    let Ok(existing) = crate::io::read_input_text(&path) else {
+    let Ok(existing) = psa_sim::io::read_input_text(&path) else {
         return Ok(());
     };
     match serde_json::from_str::<ClaimRecord>(&existing) {
@@ -155,7 +155,7 @@ pub fn clear_stale(folder: &Path, timeout: Duration) -> Result<()> {
 /// one does; should the renamed file prove to be a fresh claim made since,
 /// it is put back.
 fn take_over(path: &Path, stale: &str) -> Result<()> {
-    let aside = path.with_file_name(crate::io::temporary_name("claim.json.stale"));
+    let aside = path.with_file_name(psa_sim::io::temporary_name("claim.json.stale"));
     match std::fs::rename(path, &aside) {
         Ok(()) => {}
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
@@ -228,7 +228,7 @@ mod tests {
             serde_json::from_str(&std::fs::read_to_string(folder.join(CLAIM_FILE)).unwrap()).unwrap();
         assert_eq!(
             (found.pid, found.host.clone()),
-            (std::process::id(), crate::provenance::host_name())
+            (std::process::id(), psa_sim::provenance::host_name())
         );
         match claim(&folder, DEFAULT_CLAIM_TIMEOUT).unwrap() {
             Attempt::Held(record) => assert_eq!(record, found),
@@ -249,7 +249,7 @@ mod tests {
 
     #[test]
     fn claims_of_gone_processes_and_old_claims_are_taken_over() {
-        let host = crate::provenance::host_name();
+        let host = psa_sim::provenance::host_name();
         let me = std::process::id();
         let timeout = Duration::from_secs(3600);
         assert_eq!(record(host.clone(), me, process_start(me), 10).stale(timeout), None);

@@ -7,8 +7,8 @@ use std::str::FromStr;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::evolution::{BurstMode, Credit, EspSettings, HillClimbSettings, Sampling, TopologyMode, MAX_GENERATIONS};
-use crate::psa::PsaSettings;
+use esp_neuroevolution::{BurstMode, Credit, EspSettings, HillClimbSettings, Sampling, TopologyMode, MAX_GENERATIONS};
+use psa_sim::psa::PsaSettings;
 
 /// Which search algorithm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -199,7 +199,7 @@ impl RunConfig {
 
     /// [`RunConfig::with_overrides`] with the contents of a file.
     pub fn with_overrides_from(&self, path: &Path) -> Result<RunConfig> {
-        let text = crate::io::read_input(path, "configuration")?;
+        let text = psa_sim::io::read_input(path, "configuration")?;
         self.with_overrides(&text)
             .with_context(|| format!("configuration {}", path.display()))
     }
@@ -302,7 +302,7 @@ impl GridConfig {
     }
 
     /// Whether the configuration applies to `task` (random initialisation: tasks 1 and 3 only).
-    pub fn applies_to(self, task: crate::psa::Task) -> bool {
+    pub fn applies_to(self, task: psa_sim::psa::Task) -> bool {
         self != GridConfig::RandomInit || task.has_random_init()
     }
 }

@@ -33,12 +33,6 @@ pub use report::{write_report, ReportFormat, ReportOutcome};
 pub use results::EvolveOutcome;
 pub use run::{records_csv, run_evolution, RunFiles, RunStart};
 
-// The lower layers under the paths this crate's modules name them by
-// (`crate::psa`, `crate::evolution`, ...).
-use esp_neuroevolution as evolution;
-use esp_neuroevolution::{network, rng};
-use psa_sim::{evaluator, io, ode, physics, provenance, psa};
-
 /// The build's identity, recorded in every result file: this crate's
 /// version, the git commit (stamped by this crate's `build.rs`, with
 /// `-dirty` for uncommitted changes) and the libode version.

@@ -18,10 +18,10 @@ use rayon::prelude::*;
 use super::grid::{run_dir, GridSpec, RunKey};
 use super::grid_run::{run_seed, test_and_mark, FinishedRun};
 use super::{Algorithm, GridConfig, RunConfig, RunStart};
-use crate::evaluator::{EvalPath, PsaEvaluator};
-use crate::evolution::lockstep::lockstep_with;
-use crate::evolution::{AnyRun, AskTell, Control, Esp, HillClimb};
-use crate::psa::Task;
+use esp_neuroevolution::lockstep::lockstep_with;
+use esp_neuroevolution::{AnyRun, AskTell, Control, Esp, HillClimb};
+use psa_sim::evaluator::{EvalPath, PsaEvaluator};
+use psa_sim::psa::Task;
 
 /// A lockstep run's saved state, in its folder while it is unfinished.
 pub const CHECKPOINT: &str = "checkpoint.json";
@@ -151,14 +151,14 @@ fn save_checkpoints(runs: &[AnyRun], files: &[PathBuf]) {
             let saved = serde_json::to_vec(run).map_err(anyhow::Error::from).and_then(|json| {
                 // One that could not be read back is not written.
                 anyhow::ensure!(
-                    json.len() as u64 <= crate::io::MAX_INPUT_BYTES,
+                    json.len() as u64 <= psa_sim::io::MAX_INPUT_BYTES,
                     "the run's state takes {} bytes, more than the {} an input file may",
                     json.len(),
-                    crate::io::MAX_INPUT_BYTES
+                    psa_sim::io::MAX_INPUT_BYTES
                 );
                 Ok(json)
             });
-            if let Err(e) = saved.and_then(|json| crate::io::write_atomic(file, &json)) {
+            if let Err(e) = saved.and_then(|json| psa_sim::io::write_atomic(file, &json)) {
                 log::warn!("cannot save {}: {e:#}", file.display());
             }
         }
@@ -200,7 +200,7 @@ pub(crate) fn remove_checkpoint(folder: &Path) -> Result<()> {
 /// or is of another search is ignored, with a warning). A checkpoint is an
 /// input file as any other (docs/limits.md): anything but a regular file
 /// (a FIFO, a link, a directory, a device) or a file over
-/// [`crate::io::MAX_INPUT_BYTES`] is refused, and the run with it, by an
+/// [`psa_sim::io::MAX_INPUT_BYTES`] is refused, and the run with it, by an
 /// error naming it, before the run starts.
 fn resume(folder: &Path, fresh: AnyRun) -> Result<AnyRun> {
     let file = folder.join(CHECKPOINT);
@@ -217,7 +217,7 @@ fn resume(folder: &Path, fresh: AnyRun) -> Result<AnyRun> {
         }
         _ => {}
     }
-    let json = crate::io::read_input_text(&file)
+    let json = psa_sim::io::read_input_text(&file)
         .map_err(|problem| anyhow::anyhow!("{}: {problem}; remove it to start the run afresh", file.display()))?;
     Ok(match serde_json::from_str::<AnyRun>(&json) {
         Ok(saved) if saved.same_search(&fresh) => {
@@ -263,7 +263,7 @@ fn begin(
         }
     };
     let (inputs, outputs) = {
-        use crate::evolution::Evaluator;
+        use esp_neuroevolution::Evaluator;
         let e = &evaluators[evaluator].1;
         (e.inputs(), e.outputs())
     };

@@ -10,11 +10,11 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
 use super::robustness::{test_robustness, Robustness};
-use crate::evaluator::EvalPath;
-use crate::network::Network;
-use crate::physics::BackendKind;
-use crate::psa::{PsaSettings, Task, TrialRunner};
-use crate::rng::stream;
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::stream;
+use psa_sim::evaluator::EvalPath;
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::{PsaSettings, Task, TrialRunner};
 
 /// Stream key of the champion's fitness in the check (beside the
 /// robustness tests' keys).

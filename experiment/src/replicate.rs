@@ -17,7 +17,7 @@ use super::grid::{judge_run, run_dir, run_status, GridSpec, Judge, RunKey, RunSt
 use super::grid_run::{run_one, FinishedRun};
 use super::lockstep::{replicate_lockstep, Executor};
 use super::shard::Shard;
-use crate::evaluator::EvalPath;
+use psa_sim::evaluator::EvalPath;
 
 /// Something to tell the user while the grid runs.
 pub trait GridProgress: Sync {
@@ -96,7 +96,7 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Resul
             dir.display()
         );
     }
-    crate::io::create_output_dir(dir)?;
+    psa_sim::io::create_output_dir(dir)?;
     let mut json = serde_json::to_string_pretty(spec)?;
     json.push('\n');
     // A new grid is checked whole before its first run (a re-scored grid's
@@ -104,7 +104,7 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Resul
     if !grid_file.exists() && judge == Judge::Resume {
         spec.check_new()?;
     }
-    if !grid_file.exists() && crate::io::create_new_atomic(&grid_file, json.as_bytes())? {
+    if !grid_file.exists() && psa_sim::io::create_new_atomic(&grid_file, json.as_bytes())? {
         // This process wrote grid.json.
     } else {
         let existing = GridSpec::load(dir)?;
@@ -119,10 +119,10 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Resul
     let mut todo = Vec::new();
     let mut problems = Vec::new();
     let runs = shard.select(&spec.runs());
-    crate::io::remove_stale_temporaries(dir);
+    psa_sim::io::remove_stale_temporaries(dir);
     for key in &runs {
         let folder = run_dir(dir, key);
-        crate::io::remove_stale_temporaries(&folder);
+        psa_sim::io::remove_stale_temporaries(&folder);
         match judge_run(dir, spec, key, judge) {
             Ok(RunStatus::Finished) => {
                 // What a killed process left in a finished run.
@@ -242,7 +242,7 @@ pub fn replicate_grids(
     }
     let skipped_in_all: usize = skipped.iter().sum();
     progress.start(todo.len() + skipped_in_all, skipped_in_all);
-    let pool = crate::ode::thread_pool(options.threads)?;
+    let pool = psa_sim::ode::thread_pool(options.threads)?;
     let failures = Mutex::new(Vec::new());
     let held = Mutex::new(Vec::new());
     let counter = || grids.iter().map(|_| AtomicU64::new(0)).collect::<Vec<_>>();

@@ -27,8 +27,8 @@ use serde::Serialize;
 use super::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
 use super::runs_table::{runs_csv, RUNS_CSV};
 use super::GridConfig;
-use crate::psa::Task;
 use crate::results::{load_run, GenerationRow, RunData};
+use psa_sim::psa::Task;
 
 pub use distance::{Distance, Part, Term};
 pub use findings::{Finding, Rule, Verdict, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
@@ -245,30 +245,30 @@ impl ReportOutcome {
 pub fn write_report(dir: &Path, format: ReportFormat) -> Result<ReportOutcome> {
     let results = GridResults::load(dir)?;
     // What an earlier report, killed while writing, left.
-    crate::io::remove_stale_temporaries(dir);
-    crate::io::remove_stale_temporaries(&dir.join("figures"));
+    psa_sim::io::remove_stale_temporaries(dir);
+    psa_sim::io::remove_stale_temporaries(&dir.join("figures"));
     let mut report = Report::from_results(&results);
     let (links, figures, figure_problems) = figures::write_figures(&results, &dir.join("figures"));
     report.figures = links;
     report.figure_problems = figure_problems.clone();
     let markdown = render::markdown(&report);
     let md_path = dir.join("report.md");
-    crate::io::write_atomic(&md_path, markdown.as_bytes())?;
+    psa_sim::io::write_atomic(&md_path, markdown.as_bytes())?;
     let runs_path = dir.join(RUNS_CSV);
-    crate::io::write_atomic(&runs_path, runs_csv(&results.runs).as_bytes())?;
+    psa_sim::io::write_atomic(&runs_path, runs_csv(&results.runs).as_bytes())?;
     let mut written = vec![md_path, runs_path];
     match format {
         ReportFormat::Md => {}
         ReportFormat::Csv => {
             let path = dir.join("report.csv");
-            crate::io::write_atomic(&path, render::csv(&report).as_bytes())?;
+            psa_sim::io::write_atomic(&path, render::csv(&report).as_bytes())?;
             written.push(path);
         }
         ReportFormat::Json => {
             let path = dir.join("report.json");
             let mut json = serde_json::to_string_pretty(&report)?;
             json.push('\n');
-            crate::io::write_atomic(&path, json.as_bytes())?;
+            psa_sim::io::write_atomic(&path, json.as_bytes())?;
             written.push(path);
         }
     }

@@ -5,10 +5,10 @@ use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
 use super::PAPER_NOISE_SD;
-use crate::evaluator::{trial_scores, EvalPath};
-use crate::network::Network;
-use crate::psa::{mean_of_trials, NoiseSettings, PsaSettings, Task};
-use crate::rng::stream;
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::stream;
+use psa_sim::evaluator::{trial_scores, EvalPath};
+use psa_sim::psa::{mean_of_trials, NoiseSettings, PsaSettings, Task};
 
 /// Stream keys of the robustness tests (the evolution's own keys are below 100).
 const CLEAN: u64 = 101;

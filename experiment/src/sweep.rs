@@ -355,14 +355,14 @@ impl SweepSpec {
     /// Reads `DIR/sweep.json`, checking its format and version.
     pub fn load(dir: &Path) -> Result<SweepSpec> {
         let path = sweep_file(dir);
-        let spec: SweepSpec = crate::io::read_versioned_json(&path, SWEEP_FORMAT, SWEEP_VERSION, "sweep")?;
+        let spec: SweepSpec = psa_sim::io::read_versioned_json(&path, SWEEP_FORMAT, SWEEP_VERSION, "sweep")?;
         spec.validate().with_context(|| format!("{}", path.display()))?;
         Ok(spec)
     }
 
     /// Writes `DIR/sweep.json` atomically.
     pub fn save(&self, dir: &Path) -> Result<()> {
-        crate::io::write_json(&sweep_file(dir), self)
+        psa_sim::io::write_json(&sweep_file(dir), self)
     }
 }
 
@@ -546,11 +546,11 @@ fn prepare(dir: &Path, spec: &SweepSpec) -> Result<()> {
             dir.display()
         );
     }
-    crate::io::create_output_dir(dir)?;
-    crate::io::remove_stale_temporaries(dir);
+    psa_sim::io::create_output_dir(dir)?;
+    psa_sim::io::remove_stale_temporaries(dir);
     let mut json = serde_json::to_string_pretty(spec)?;
     json.push('\n');
-    if !sweep_file(dir).exists() && crate::io::create_new_atomic(&sweep_file(dir), json.as_bytes())? {
+    if !sweep_file(dir).exists() && psa_sim::io::create_new_atomic(&sweep_file(dir), json.as_bytes())? {
         return Ok(());
     }
     let existing = SweepSpec::load(dir)?;
@@ -620,7 +620,7 @@ mod tests {
 
     #[test]
     fn every_reading_of_the_fitness_and_the_inputs_can_be_varied() {
-        use crate::psa::{FitnessKind, FitnessState, HeadingInput, HeadingWrap, Scoring, Task};
+        use psa_sim::psa::{FitnessKind, FitnessState, HeadingInput, HeadingWrap, Scoring, Task};
         let vary = [
             "problem.fitness.kind=incremental,original",
             "problem.fitness.scoring=evolution,original",

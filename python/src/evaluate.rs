@@ -7,14 +7,14 @@ use std::ops::Range;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
+use esp_neuroevolution::network::Network;
 use esp_neuroevolution::rayon::prelude::*;
 use esp_neuroevolution::rayon::ThreadPool;
+use esp_neuroevolution::rng::{stream, Stream};
 use esp_neuroevolution::{evaluate_all, Evaluator};
 use numpy::{IntoPyArray, PyArray1};
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
-use psa_sim::network::Network;
 use psa_sim::psa::{PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
-use psa_sim::rng::{stream, Stream};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyInt;

@@ -4,13 +4,13 @@
 use std::path::PathBuf;
 
 use esp_neuroevolution::math::Exponential;
+use esp_neuroevolution::network::Network as Weights;
+use esp_neuroevolution::rng::stream;
 use numpy::{PyArray1, PyArray2};
 use psa_experiment::robustness::TrialSummary;
 use psa_experiment::RunConfig;
-use psa_sim::network::Network as Weights;
 use psa_sim::psa::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
-use psa_sim::rng::stream;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyModule};

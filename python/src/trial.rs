@@ -3,12 +3,12 @@
 //! trial's step (`psa_sim::psa::trial`), operation for operation, so a
 //! network flown through it scores what `evaluate` gives.
 
+use esp_neuroevolution::rng::stream;
 use numpy::{PyArray1, PyArrayMethods};
 use psa_sim::numeric::{clamp_unit, NoiseSource};
 use psa_sim::physics::{create_backend, PhysicsBackend, PlanarState};
 use psa_sim::psa::step::{score, sense, Reading};
 use psa_sim::psa::{PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
-use psa_sim::rng::stream;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 

@@ -32,8 +32,4 @@ pub mod physics;
 pub mod provenance;
 pub mod psa;
 
-// The search crate under the paths the simulator has always used.
-pub use esp_neuroevolution as evolution;
-pub use esp_neuroevolution::{network, rng};
-
 pub use evaluator::{EvalPath, PsaEvaluator, PsaWorker};

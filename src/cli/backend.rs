@@ -5,9 +5,9 @@ use anyhow::Result;
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use std::sync::Arc;
 
-use crate::evaluator::EvalPath;
-use crate::physics::BackendKind;
-use crate::psa::cuda::CudaTrials;
+use psa_sim::evaluator::EvalPath;
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::cuda::CudaTrials;
 
 /// Where the trials of a run fly.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

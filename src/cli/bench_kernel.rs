@@ -11,10 +11,10 @@ use serde::Serialize;
 
 use super::bench_networks::random_networks;
 use super::bench_runs::median;
-use crate::network::Network;
-use crate::physics::{BackendKind, PlanarBody};
-use crate::psa::cuda::{prepare, CudaTrials, HostTrials, TrialFlier};
-use crate::psa::{BatchRunner, PsaSettings, Task};
+use esp_neuroevolution::network::Network;
+use psa_sim::physics::{BackendKind, PlanarBody};
+use psa_sim::psa::cuda::{prepare, CudaTrials, HostTrials, TrialFlier};
+use psa_sim::psa::{BatchRunner, PsaSettings, Task};
 
 /// Networks the `native` column flies at most.
 pub const NATIVE_NETWORKS: usize = 4_000;
@@ -92,7 +92,7 @@ pub fn kernel_rows(sizes: &[u64], rounds: u64, on_host: bool) -> Result<KernelBe
         let (mut kernel, mut end_to_end, mut cpu) = (Vec::new(), Vec::new(), Vec::new());
         for round in 0..rounds {
             let mut streams: Vec<_> = (0..networks.len())
-                .map(|j| crate::rng::stream(round, &[j as u64]))
+                .map(|j| esp_neuroevolution::rng::stream(round, &[j as u64]))
                 .collect();
             let batch = prepare(&settings, &body, task, &refs[..], 0..refs.len(), &mut streams.clone())?;
             let start = Instant::now();

@@ -3,16 +3,16 @@
 
 use anyhow::Result;
 
-use crate::evolution::operators::random_genes;
-use crate::network::Network;
-use crate::psa::{INPUT_COUNT, THRUSTER_COUNT};
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::operators::random_genes;
+use psa_sim::psa::{INPUT_COUNT, THRUSTER_COUNT};
 
 /// Hidden neurons of the benchmark's networks (the paper's 7-5-4 network).
 pub const HIDDEN: usize = 5;
 
 /// Random 7-5-4 networks, weights uniform in (-6, 6) as ESP starts them.
 pub fn random_networks(count: u64) -> Result<Vec<Network>> {
-    let mut rng = crate::rng::stream(1, &[]);
+    let mut rng = esp_neuroevolution::rng::stream(1, &[]);
     (0..count)
         .map(|_| {
             Ok(Network::from_genes(

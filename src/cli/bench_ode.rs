@@ -8,9 +8,9 @@ use anyhow::Result;
 use serde::Serialize;
 
 use super::bench_runs::median;
-use crate::network::Network;
-use crate::psa::{OdeLockstepRunner, PsaSettings, Task};
-use crate::rng::{stream, Stream};
+use esp_neuroevolution::network::Network;
+use esp_neuroevolution::rng::{stream, Stream};
+use psa_sim::psa::{OdeLockstepRunner, PsaSettings, Task};
 
 /// The world sizes measured.
 pub const WORLD_SIZES: [usize; 6] = [1, 4, 8, 16, 32, 64];

@@ -9,16 +9,16 @@ use std::time::Instant;
 use anyhow::Result;
 use serde::Serialize;
 
-use crate::evaluator::{EvalPath, PsaEvaluator};
-use crate::evolution::{Esp, Evaluator};
-use crate::experiment::grid::{GridPreset, GridSpec};
-use crate::experiment::grid_run::FinishedRun;
-use crate::experiment::replicate::{replicate, GridProgress, ReplicateOptions};
-use crate::experiment::{GridConfig, Preset, RunConfig};
-use crate::network::{Network, NetworkSet};
-use crate::physics::BackendKind;
-use crate::psa::Task;
-use crate::rng::{Stream, StreamFamily};
+use esp_neuroevolution::network::{Network, NetworkSet};
+use esp_neuroevolution::rng::{Stream, StreamFamily};
+use esp_neuroevolution::{Esp, Evaluator};
+use psa_experiment::grid::{GridPreset, GridSpec};
+use psa_experiment::grid_run::FinishedRun;
+use psa_experiment::replicate::{replicate, GridProgress, ReplicateOptions};
+use psa_experiment::{GridConfig, Preset, RunConfig};
+use psa_sim::evaluator::{EvalPath, PsaEvaluator};
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::Task;
 
 /// A whole-run workload timed on 1 and on 2 threads.
 #[derive(Debug, Serialize)]
@@ -103,7 +103,7 @@ pub fn evolve_workload(generations: usize) -> Result<Workload> {
         name: "evolve",
         description: format!("one baseline ESP run, task 3, native, {generations} generations"),
         work: Box::new(move |threads| {
-            crate::ode::thread_pool(threads)?.install(|| esp.run(&evaluator, |_| {}))?;
+            psa_sim::ode::thread_pool(threads)?.install(|| esp.run(&evaluator, |_| {}))?;
             Ok(())
         }),
     })
@@ -200,7 +200,7 @@ pub fn algorithm_overhead(generations: usize, rounds: u64) -> Result<AlgorithmOv
     let config = baseline(generations)?;
     let evaluator = PsaEvaluator::new(config.problem.clone(), Task::StopAtPosition, &EvalPath::Fastest)?;
     let esp = Esp::new(config.esp.clone(), 1).map_err(anyhow::Error::msg)?;
-    let pool = crate::ode::thread_pool(1)?;
+    let pool = psa_sim::ode::thread_pool(1)?;
     let mut shares = Vec::new();
     for _ in 0..rounds {
         let nanos = AtomicU64::new(0);

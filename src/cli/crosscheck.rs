@@ -3,9 +3,9 @@
 use anyhow::Result;
 
 use super::{PhysicsArgs, EXIT_CHECK_FAILED};
-use crate::physics::crosscheck;
-use crate::psa::limits::MAX_STEPS;
-use crate::psa::BodySettings;
+use psa_sim::physics::crosscheck;
+use psa_sim::psa::limits::MAX_STEPS;
+use psa_sim::psa::BodySettings;
 
 /// The most random thrust sequences of one cross-check (only time grows with them).
 const MAX_SEQUENCES: u64 = 100_000;

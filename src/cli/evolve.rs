@@ -7,9 +7,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::backend::{BackendArg, EvalPathArg};
 use super::choice::choice;
-use crate::experiment::{run_evolution, Preset};
-use crate::ode::MAX_THREADS;
-use crate::psa::Task;
+use psa_experiment::{run_evolution, Preset};
+use psa_sim::ode::MAX_THREADS;
+use psa_sim::psa::Task;
 
 /// Arguments of `evolve`.
 #[derive(Debug, clap::Args)]
@@ -85,7 +85,7 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
         config.generations() as u64,
         "{spinner} generation {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
     );
-    let pool = crate::ode::thread_pool(args.threads as usize)?;
+    let pool = psa_sim::ode::thread_pool(args.threads as usize)?;
     let outcome = pool.install(|| {
         run_evolution(
             &config,

@@ -33,7 +33,7 @@ pub const EXIT_ERROR: i32 = 2;
 
 /// Evolving neural controllers for the Personal Satellite Assistant.
 #[derive(Debug, Parser)]
-#[command(name = "psa-esp", version = crate::experiment::version(), about, long_about = None)]
+#[command(name = "psa-esp", version = psa_experiment::version(), about, long_about = None)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -82,7 +82,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
 #[derive(Debug, Clone, clap::Args)]
 pub struct PhysicsArgs {
     /// Time step (s).
-    #[arg(long, default_value_t = crate::physics::StepSettings::default().dt, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = psa_sim::physics::StepSettings::default().dt, allow_negative_numbers = true)]
     pub dt: f64,
     /// ODE stepper: exact (dWorldStep) or quick (dWorldQuickStep).
     #[arg(long, value_parser = ["exact", "quick"], default_value = "exact")]
@@ -94,10 +94,10 @@ pub struct PhysicsArgs {
 
 impl PhysicsArgs {
     /// The step settings these options describe; `--dt` must be in the
-    /// range of `physics.dt` ([`crate::psa::limits`]).
-    pub fn settings(&self) -> anyhow::Result<crate::physics::StepSettings> {
-        use crate::physics::{PlaneConstraint, StepSettings, Stepper};
-        crate::psa::limits::check_as("physics.dt", "--dt", self.dt).map_err(anyhow::Error::msg)?;
+    /// range of `physics.dt` ([`psa_sim::psa::limits`]).
+    pub fn settings(&self) -> anyhow::Result<psa_sim::physics::StepSettings> {
+        use psa_sim::physics::{PlaneConstraint, StepSettings, Stepper};
+        psa_sim::psa::limits::check_as("physics.dt", "--dt", self.dt).map_err(anyhow::Error::msg)?;
         let settings = StepSettings {
             dt: self.dt,
             stepper: if self.stepper == "quick" {
@@ -128,7 +128,7 @@ pub fn trajectory_row(
     out: &mut impl std::fmt::Write,
     i: u64,
     dt: f64,
-    s: &crate::physics::BodyState,
+    s: &psa_sim::physics::BodyState,
     extra: &str,
 ) -> std::fmt::Result {
     writeln!(
@@ -148,7 +148,7 @@ pub fn trajectory_row(
 /// `extra_header` (which starts with a comma when not empty) filled per row
 /// by `extra(row)`.
 pub fn trajectory_csv(
-    states: &[crate::physics::BodyState],
+    states: &[psa_sim::physics::BodyState],
     dt: f64,
     extra_header: &str,
     extra: impl Fn(usize) -> String,

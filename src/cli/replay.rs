@@ -6,11 +6,11 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 
 use super::choice::choice;
-use crate::experiment::robustness::TrialSummary;
-use crate::physics::BackendKind;
-use crate::plots::{write_trial_pictures, TrialPicture};
-use crate::psa::limits::{check_as, MAX_TRIALS};
-use crate::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
+use psa_experiment::plots::{write_trial_pictures, TrialPicture};
+use psa_experiment::robustness::TrialSummary;
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::limits::{check_as, MAX_TRIALS};
+use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
 
 /// Key of the random stream of replays.
 const REPLAY_STREAM: u64 = 301;
@@ -65,7 +65,7 @@ struct ReplaySummary {
     task: Task,
     backend: BackendKind,
     trials: u64,
-    #[serde(serialize_with = "crate::io::u64_string::serialize")]
+    #[serde(serialize_with = "psa_sim::io::u64_string::serialize")]
     seed: u64,
     input_noise: f64,
     output_noise: f64,
@@ -77,7 +77,7 @@ struct ReplaySummary {
 }
 
 fn write_outputs(dir: &Path, record: &TrialRecord, settings: &PsaSettings, title: String) -> Result<Vec<PathBuf>> {
-    crate::io::create_output_dir(dir)?;
+    psa_sim::io::create_output_dir(dir)?;
     let csv = super::trajectory_csv(&record.states, settings.physics.dt, ",u0,u1,u2,u3,points", |i| {
         match (
             i.checked_sub(1).and_then(|k| record.outputs.get(k)),
@@ -88,7 +88,7 @@ fn write_outputs(dir: &Path, record: &TrialRecord, settings: &PsaSettings, title
         }
     });
     let csv_path = dir.join("trajectory.csv");
-    crate::io::write_atomic(&csv_path, csv.as_bytes())?;
+    psa_sim::io::write_atomic(&csv_path, csv.as_bytes())?;
     let picture = TrialPicture {
         title,
         dt: settings.physics.dt,
@@ -119,9 +119,9 @@ fn model(args: &ReplayArgs, file: &NetworkFile) -> Result<PsaSettings> {
     match &args.config {
         None => Ok(recorded),
         Some(path) => {
-            let base = crate::experiment::RunConfig {
+            let base = psa_experiment::RunConfig {
                 problem: recorded,
-                ..crate::experiment::RunConfig::default()
+                ..psa_experiment::RunConfig::default()
             };
             Ok(base.with_overrides_from(path)?.problem)
         }
@@ -150,7 +150,7 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
         ..model
     };
     let mut runner = TrialRunner::new(&settings, task)?;
-    let mut rng = crate::rng::stream(args.seed, &[REPLAY_STREAM]);
+    let mut rng = esp_neuroevolution::rng::stream(args.seed, &[REPLAY_STREAM]);
     let maximum = runner.maximum_points();
     let mut first = TrialRecord::default();
     let mut per_trial = Vec::with_capacity(settings.trials);

@@ -10,18 +10,18 @@ use anyhow::Result;
 use super::backend::{BackendArg, EvalPathArg};
 use super::choice::choice;
 use super::evolve::progress_bar;
-use crate::evaluator::EvalPath;
-use crate::evolution::MAX_GENERATIONS;
-use crate::experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
-use crate::experiment::grid_run::FinishedRun;
-use crate::experiment::lockstep::Executor;
-use crate::experiment::replicate::{describe, replicate, GridProgress, HeldRun, ReplicateOptions};
-use crate::experiment::shard::Shard;
-use crate::experiment::GridConfig;
-use crate::ode::MAX_THREADS;
-use crate::physics::BackendKind;
-use crate::psa::limits::MAX_TRIALS;
-use crate::psa::Task;
+use esp_neuroevolution::MAX_GENERATIONS;
+use psa_experiment::grid::{GridPreset, GridSpec, MAX_SEEDS};
+use psa_experiment::grid_run::FinishedRun;
+use psa_experiment::lockstep::Executor;
+use psa_experiment::replicate::{describe, replicate, GridProgress, HeldRun, ReplicateOptions};
+use psa_experiment::shard::Shard;
+use psa_experiment::GridConfig;
+use psa_sim::evaluator::EvalPath;
+use psa_sim::ode::MAX_THREADS;
+use psa_sim::physics::BackendKind;
+use psa_sim::psa::limits::MAX_TRIALS;
+use psa_sim::psa::Task;
 
 /// Arguments of `replicate`.
 #[derive(Debug, clap::Args)]
@@ -161,8 +161,8 @@ impl GridArgs {
 /// The text of a `--config` file, checked to be a valid overlay of the baseline.
 pub fn read_overrides(path: &std::path::Path) -> Result<String> {
     use anyhow::Context;
-    let text = crate::io::read_input(path, "configuration")?;
-    crate::experiment::RunConfig::baseline_with(&text).with_context(|| format!("configuration {}", path.display()))?;
+    let text = psa_sim::io::read_input(path, "configuration")?;
+    psa_experiment::RunConfig::baseline_with(&text).with_context(|| format!("configuration {}", path.display()))?;
     Ok(text)
 }
 

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use super::choice::choice;
-use crate::experiment::report::{write_report, ReportFormat};
+use psa_experiment::report::{write_report, ReportFormat};
 
 /// Arguments of `report`.
 #[derive(Debug, clap::Args)]
@@ -24,8 +24,8 @@ pub struct ReportArgs {
 /// another configuration (the report is written all the same, without it).
 /// A directory that is not a grid is an error (exit code 2).
 pub fn run(args: ReportArgs) -> Result<i32> {
-    if crate::experiment::sweep::sweep_file(&args.dir).exists() {
-        let (_, markdown, written) = crate::experiment::report::write_sweep_report(&args.dir)?;
+    if psa_experiment::sweep::sweep_file(&args.dir).exists() {
+        let (_, markdown, written) = psa_experiment::report::write_sweep_report(&args.dir)?;
         say!("{}", markdown.trim_end());
         for path in written {
             eprintln!("wrote {}", path.display());

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use super::replicate::read_overrides;
-use crate::experiment::grid::GridSpec;
-use crate::experiment::rescore::{check_out, check_rescoring_acts, rescore, rescored_spec};
-use crate::ode::MAX_THREADS;
-use crate::psa::limits::MAX_TRIALS;
+use psa_experiment::grid::GridSpec;
+use psa_experiment::rescore::{check_out, check_rescoring_acts, rescore, rescored_spec};
+use psa_sim::ode::MAX_THREADS;
+use psa_sim::psa::limits::MAX_TRIALS;
 
 /// Arguments of `rescore`.
 #[derive(Debug, clap::Args)]

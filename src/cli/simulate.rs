@@ -7,8 +7,8 @@ use anyhow::{bail, Result};
 
 use super::choice::choice;
 use super::{PhysicsArgs, TRAJECTORY_HEADER};
-use crate::physics::{create_backend, for_each_state, BackendKind, BodyState, PhysicsBackend};
-use crate::psa::{limits, BodySettings, THRUSTER_COUNT};
+use psa_sim::physics::{create_backend, for_each_state, BackendKind, BodyState, PhysicsBackend};
+use psa_sim::psa::{limits, BodySettings, THRUSTER_COUNT};
 
 /// Arguments of `simulate`.
 #[derive(Debug, clap::Args)]
@@ -56,7 +56,7 @@ const DEFAULT_STEPS: u64 = 500;
 pub const MAX_STEPS: u64 = 1_000_000_000;
 
 fn read_thrust_file(path: &Path) -> Result<Vec<Vec<f64>>> {
-    let text = crate::io::read_input(path, "thrust file")?;
+    let text = psa_sim::io::read_input(path, "thrust file")?;
     let mut rows = Vec::new();
     for (number, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
@@ -180,7 +180,7 @@ pub fn run(args: SimulateArgs) -> Result<i32> {
     match &args.out {
         Some(path) => {
             let mut written = 0;
-            crate::io::write_atomic_with(path, |out| {
+            psa_sim::io::write_atomic_with(path, |out| {
                 written = write_trajectory(out, backend.as_mut(), &start, &commands, settings.dt)?;
                 Ok(())
             })?;

@@ -97,7 +97,7 @@ fn unwrapped_headings(picture: &TrialPicture) -> Vec<f64> {
     for state in picture.states {
         let heading = match previous {
             None => state.heading,
-            Some(p) => p + crate::physics::wrap_angle(state.heading - p),
+            Some(p) => p + psa_sim::physics::wrap_angle(state.heading - p),
         };
         out.push(heading);
         previous = Some(heading);

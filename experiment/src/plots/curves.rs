@@ -101,7 +101,7 @@ pub fn write_curve_figure(figure: &CurveFigure, dir: &Path, stem: &str) -> Resul
     figure.validate()?;
     ensure!(!stem.is_empty(), "the file stem must not be empty");
     ensure_font()?;
-    crate::io::create_output_dir(dir)?;
+    psa_sim::io::create_output_dir(dir)?;
     let svg_path = dir.join(format!("{stem}.svg"));
     let png_path = dir.join(format!("{stem}.png"));
 

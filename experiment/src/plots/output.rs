@@ -66,15 +66,15 @@ pub(crate) fn write_svg_and_png(
         root.present()
             .with_context(|| format!("drawing {}", svg_path.display()))?;
     }
-    crate::io::write_atomic(svg_path, svg.as_bytes())?;
-    crate::io::check_output_file(png_path)?;
+    psa_sim::io::write_atomic(svg_path, svg.as_bytes())?;
+    psa_sim::io::check_output_file(png_path)?;
     let dir = png_path.parent().unwrap_or(Path::new("."));
     let name = png_path
         .file_name()
         .map_or("figure.png".into(), |s| s.to_string_lossy());
     // A temporary name of the usual form (so that a killed report's is
     // cleared by the next), ending in .png for the drawing backend.
-    let tmp = dir.join(format!("{}.png", crate::io::temporary_name(&name)));
+    let tmp = dir.join(format!("{}.png", psa_sim::io::temporary_name(&name)));
     let drawn = (|| -> Result<()> {
         let root = BitMapBackend::new(&tmp, size).into_drawing_area();
         drawing.draw(&root)?;

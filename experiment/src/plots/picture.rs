@@ -6,7 +6,7 @@
 use anyhow::{bail, ensure};
 use plotters::style::RGBColor;
 
-use crate::physics::{wrap_angle, BodyState};
+use psa_sim::physics::{wrap_angle, BodyState};
 
 /// Legend text of each thruster, in thruster order.
 pub const THRUSTER_NAMES: [&str; 4] = [

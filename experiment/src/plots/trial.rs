@@ -45,7 +45,7 @@ pub fn write_trial_pictures(picture: &TrialPicture, dir: &Path, stem: &str) -> a
     picture.validate()?;
     ensure!(!stem.is_empty(), "the file stem must not be empty");
     ensure_font()?;
-    crate::io::create_output_dir(dir)?;
+    psa_sim::io::create_output_dir(dir)?;
 
     let svg_path = dir.join(format!("{stem}.svg"));
     let png_path = dir.join(format!("{stem}.png"));
@@ -53,7 +53,7 @@ pub fn write_trial_pictures(picture: &TrialPicture, dir: &Path, stem: &str) -> a
 
     write_svg_and_png(picture, (FIGURE_WIDTH, FIGURE_HEIGHT), &svg_path, &png_path)?;
     let svg = animation::animation_svg(picture);
-    crate::io::write_atomic(&animation_path, svg.as_bytes())?;
+    psa_sim::io::write_atomic(&animation_path, svg.as_bytes())?;
 
     Ok(vec![svg_path, png_path, animation_path])
 }
@@ -394,8 +394,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::BodyState;
     use crate::plots::picture::tests::{picture, spiral};
+    use psa_sim::physics::BodyState;
 
     #[test]
     fn writes_all_three_pictures() {

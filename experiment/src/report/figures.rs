@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 use super::tables::FigureLink;
 use super::{GenerationRow, GridResults};
 use crate::plots::curves::{write_curve_figure, CurveFigure, Series};
-use crate::psa::Task;
 use crate::stats::mean_sd;
 use crate::{Algorithm, GridConfig, Preset};
+use psa_sim::psa::Task;
 
 const Y_DESC: &str = "fitness (% of theoretical maximum)";
 

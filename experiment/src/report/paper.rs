@@ -5,8 +5,8 @@
 use serde::Serialize;
 
 use super::Metric;
-use crate::psa::Task;
 use crate::{GridConfig, Preset};
+use psa_sim::psa::Task;
 
 /// One cell of a paper table.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

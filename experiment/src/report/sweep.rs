@@ -324,9 +324,9 @@ pub fn write_sweep_report(dir: &Path) -> Result<(SweepReport, String, Vec<PathBu
     let (report, grids) = SweepReport::load_with_results(dir)?;
     let markdown = report.markdown();
     let md_path = dir.join("sweep-report.md");
-    crate::io::write_atomic(&md_path, markdown.as_bytes())?;
+    psa_sim::io::write_atomic(&md_path, markdown.as_bytes())?;
     let json_path = dir.join("sweep-report.json");
-    crate::io::write_json(&json_path, &report)?;
+    psa_sim::io::write_json(&json_path, &report)?;
     let keys: Vec<String> = report.sweep.vary.iter().map(|v| v.key.clone()).collect();
     let variants: Vec<VariantRuns> = report
         .variants
@@ -339,7 +339,7 @@ pub fn write_sweep_report(dir: &Path) -> Result<(SweepReport, String, Vec<PathBu
         })
         .collect();
     let runs_path = dir.join(RUNS_CSV);
-    crate::io::write_atomic(&runs_path, sweep_runs_csv(&keys, &variants)?.as_bytes())?;
+    psa_sim::io::write_atomic(&runs_path, sweep_runs_csv(&keys, &variants)?.as_bytes())?;
     Ok((report, markdown, vec![md_path, json_path, runs_path]))
 }
 

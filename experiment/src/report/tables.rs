@@ -10,11 +10,11 @@ use super::findings::{findings, Finding};
 use super::paper::{paper_bursts, paper_cell, PaperCell};
 use super::{GridResults, Metric, Problem};
 use crate::grid::{GridPreset, GridSpec, RunStatus};
-use crate::provenance::BuildInfo;
-use crate::psa::Task;
 use crate::stats::{mean_sd, welch};
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
+use psa_sim::provenance::BuildInfo;
+use psa_sim::psa::Task;
 
 /// One row of a table: a configuration's champions on a task (or All).
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -2,7 +2,7 @@
 //! every lane runs its own generator, and the arithmetic is shared.
 
 use super::{ln, sin_cos_quarter_turns, Real, Words};
-use crate::rng::expand;
+use esp_neuroevolution::rng::expand;
 
 /// Unsigned 64-bit words, or a bundle of them (one per lane): the state and
 /// output of the noise generator.

@@ -24,8 +24,8 @@ use thiserror::Error;
 use super::sensors::SensorSettings;
 use super::task::Task;
 use super::trial::PsaSettings;
-use crate::network::Network;
 use crate::provenance::BuildInfo;
+use esp_neuroevolution::network::Network;
 
 /// The dotted path (`.sensors.heading_wrap`) of the first leaf of the JSON
 /// object `doc` that alone makes it fail to read, laid over the defaults
