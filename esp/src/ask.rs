@@ -7,7 +7,7 @@
 //! test's, the hill-climber's base) with the random streams each must be
 //! evaluated with, and that [`AskTell::tell`] advances by their fitness.
 //! Whoever evaluates them (one thread, a cluster, a GPU, or one batch for
-//! many runs, as [`lockstep`](crate::lockstep) does) gets the same run, bit
+//! many runs, as [`run_together`](crate::together::run_together) does) gets the same run, bit
 //! for bit, as [`Esp::run`](crate::Esp::run), which is itself a loop over
 //! ask, evaluate and tell.
 

@@ -61,7 +61,7 @@ pub trait Evaluator: Sync {
         evaluate_each(self, worker, networks, range, streams)
     }
 
-    /// Whether [`crate::lockstep`] should hand this evaluator all of a
+    /// Whether [`crate::together`] should hand this evaluator all of a
     /// round's networks that it scores in one call of
     /// [`Evaluator::evaluate_parts`] (an evaluator that pays per call, such
     /// as a GPU launch), instead of cutting each run's networks into

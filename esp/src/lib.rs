@@ -35,7 +35,7 @@
 //!
 //! A run can also be driven from outside, by ask and tell ([`AskTell`]):
 //! [`Esp::start`] and [`HillClimb::start`] make runs that ask for networks
-//! and are told their fitness with the ask's [`Ticket`]; [`lockstep`]
+//! and are told their fitness with the ask's [`Ticket`]; [`together`]
 //! advances many such runs together, evaluating every round's networks of
 //! all of them in one batch. Either way a run is the one [`Esp::run`]
 //! gives, bit for bit. A run under way ([`EspRun`], [`HillClimbRun`],
@@ -53,7 +53,6 @@ mod esp;
 mod evaluator;
 mod hill_climb;
 pub mod limits;
-pub mod lockstep;
 pub mod math;
 pub mod network;
 pub mod operators;
@@ -62,6 +61,7 @@ mod record;
 pub mod rng;
 mod run;
 mod subpop;
+pub mod together;
 
 pub use any_run::AnyRun;
 pub use ask::{AskPurpose, AskTell, Asked, Ticket};

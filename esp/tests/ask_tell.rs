@@ -1,9 +1,9 @@
 //! Ask/tell: driving a run by hand, or many together, is the same run as
 //! `run`, bit for bit; and mistakes in driving it are typed errors.
 
-use esp_neuroevolution::lockstep::{evaluate_jobs, lockstep, Job};
 use esp_neuroevolution::network::{Network, NetworkSet};
 use esp_neuroevolution::rng::Stream;
+use esp_neuroevolution::together::{evaluate_jobs, run_together, Job};
 use esp_neuroevolution::{
     evaluate_all, evaluate_each_part, AskPurpose, AskTell, Control, Ending, Esp, EspSettings, Evaluator, FnEvaluator,
     GenerationRecord, HillClimb, HillClimbSettings, Part, RunError, RunResult, StopAt, TopologyMode,
@@ -194,7 +194,7 @@ fn a_wrong_tell_is_a_typed_error_that_leaves_the_run_as_it_was() {
 }
 
 #[test]
-fn runs_in_lockstep_are_each_their_own_run_bit_for_bit() {
+fn runs_run_together_are_each_their_own_run_bit_for_bit() {
     let (a, b) = (problem(), problem());
     let settings = HillClimbSettings {
         hidden: 2,
@@ -251,7 +251,7 @@ fn runs_in_lockstep_are_each_their_own_run_bit_for_bit() {
         let mut fresh: Vec<Box<dyn AskTell + Send>> = Vec::new();
         std::mem::swap(&mut fresh, &mut runs);
         let errors = pool.install(|| {
-            lockstep(&mut fresh, &evaluators, |i, r| {
+            run_together(&mut fresh, &evaluators, |i, r| {
                 if i == 3 {
                     stop_at_12(r)
                 } else {
@@ -276,7 +276,7 @@ fn runs_in_lockstep_are_each_their_own_run_bit_for_bit() {
 }
 
 #[test]
-fn a_failing_run_in_lockstep_fails_alone() {
+fn a_failing_run_among_runs_together_fails_alone() {
     // Network evaluations fail once the weights grow past 30; the
     // hill-climber with large noise gets there, ESP's runs never do.
     let evaluator = FnEvaluator::new(2, 1, |net: &Network, rng: &mut Stream| {
@@ -308,7 +308,7 @@ fn a_failing_run_in_lockstep_fails_alone() {
     let alone = calm.run(&evaluator, |_| {}).unwrap();
     let mut runs: Vec<Box<dyn AskTell + Send>> =
         vec![Box::new(wild.start(2, 1).unwrap()), Box::new(calm.start(2, 1).unwrap())];
-    let errors = lockstep(&mut runs, &[&evaluator, &evaluator], |_, _| Control::Continue);
+    let errors = run_together(&mut runs, &[&evaluator, &evaluator], |_, _| Control::Continue);
     let message = format!("{:#}", errors[0].as_ref().expect("the wild run fails"));
     assert!(message.contains("too large"), "{message}");
     assert!(errors[1].is_none());
@@ -387,7 +387,7 @@ fn an_evaluator_that_takes_parts_together_gets_every_run_of_a_round_in_one_call(
         .map(|e| Box::new(e.start(2, 1).unwrap()) as Box<dyn AskTell + Send>)
         .collect();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-    let errors = pool.install(|| lockstep(&mut runs, &[&together; 4], |_, _| Control::Continue));
+    let errors = pool.install(|| run_together(&mut runs, &[&together; 4], |_, _| Control::Continue));
     assert!(errors.iter().all(Option::is_none), "{errors:?}");
     for (run, expected) in runs.iter().zip(&expected) {
         assert_eq!(bits(&run.result().unwrap()), bits(expected));

@@ -249,8 +249,8 @@ fn a_minimum_improvement_lets_a_creeping_run_burst() {
 }
 
 #[test]
-fn runs_in_lockstep_saved_after_a_round_resume_to_their_own_runs() {
-    use esp_neuroevolution::lockstep::lockstep_with;
+fn runs_together_saved_after_a_round_resume_to_their_own_runs() {
+    use esp_neuroevolution::together::run_together_with;
     use esp_neuroevolution::Control;
     let evaluator = problem();
     let esp = Esp::new(small(EspSettings::hoverstad()), 5).unwrap();
@@ -274,7 +274,7 @@ fn runs_in_lockstep_saved_after_a_round_resume_to_their_own_runs() {
     // Saved after round 7, as a killed process would have left them.
     let mut saved = String::new();
     let mut runs = start();
-    let errors = lockstep_with(
+    let errors = run_together_with(
         &mut runs,
         &evaluators,
         |_, _| Control::Continue,
@@ -290,7 +290,7 @@ fn runs_in_lockstep_saved_after_a_round_resume_to_their_own_runs() {
     assert!(restored
         .iter()
         .all(|run| !run.records().is_empty() && run.ending().is_none()));
-    let errors = lockstep_with(&mut restored, &evaluators, |_, _| Control::Continue, |_, _| {});
+    let errors = run_together_with(&mut restored, &evaluators, |_, _| Control::Continue, |_, _| {});
     assert!(errors.iter().all(Option::is_none));
     for ((resumed, uninterrupted), alone) in restored.into_iter().zip(runs).zip(&alone) {
         assert_eq!(bits(&resumed.into_result().unwrap()), bits(alone));

@@ -1,7 +1,7 @@
 //! The lockstep grid executor: every run of a grid, or of several grids
 //! (a sweep's variants), or of what is left of them, advanced together,
 //! one round per generation, each round's networks of all runs evaluated
-//! in one batch (the search crate's [`lockstep_with`]).
+//! in one batch (the search crate's [`run_together_with`]).
 //! Each run is the run it is on its own, bit for bit: its files are
 //! byte-identical to those of the run-by-run executor (run.json's times
 //! aside). Every `CHECKPOINT_ROUNDS` rounds or more (so that saving takes
@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use super::grid::{run_dir, GridSpec, RunKey};
 use super::grid_run::{run_seed, test_and_mark, FinishedRun};
 use super::{Algorithm, GridConfig, RunConfig, RunStart};
-use esp_neuroevolution::lockstep::lockstep_with;
+use esp_neuroevolution::together::run_together_with;
 use esp_neuroevolution::{AnyRun, AskTell, Control, Esp, HillClimb};
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
 use psa_sim::psa::Task;
@@ -106,7 +106,7 @@ pub(super) fn replicate_lockstep(
         Control::Continue
     };
     let (mut last_save, mut save_time) = (std::time::Instant::now(), std::time::Duration::ZERO);
-    let errors = lockstep_with(&mut runs, &which, on_record, |round, runs| {
+    let errors = run_together_with(&mut runs, &which, on_record, |round, runs| {
         if round % CHECKPOINT_ROUNDS == 0
             && save_time.as_secs_f64() <= CHECKPOINT_SHARE * last_save.elapsed().as_secs_f64()
         {

@@ -3,7 +3,7 @@
 //!
 //! A run's results depend on its settings and seed only, never on who
 //! evaluates its networks or beside which others ([`crate::AskTell`]), so
-//! [`lockstep`] gives every run exactly what it gives on its own. What it
+//! [`run_together`] gives every run exactly what it gives on its own. What it
 //! changes is the shape of the work: one batch of every run's networks per
 //! round instead of one per run and generation, which suits an evaluator
 //! that pays per call (a GPU launch) more than per network.
@@ -185,15 +185,15 @@ fn evaluate_piece<E: Evaluator, S: NetworkSet + ?Sized>(
 ///
 /// # Panics
 /// If `evaluators` and `runs` differ in length.
-pub fn lockstep<R: AskTell + Send, E: Evaluator>(
+pub fn run_together<R: AskTell + Send, E: Evaluator>(
     runs: &mut [R],
     evaluators: &[&E],
     on_record: impl Fn(usize, &GenerationRecord) -> Control + Sync,
 ) -> Vec<Option<RunError>> {
-    lockstep_with(runs, evaluators, on_record, |_, _| {})
+    run_together_with(runs, evaluators, on_record, |_, _| {})
 }
 
-/// [`lockstep`], calling `after_round(round, runs)` after every round
+/// [`run_together`], calling `after_round(round, runs)` after every round
 /// (from 1) with all the runs as they stand: the place to save them
 /// (serde: [`AnyRun`](crate::AnyRun), [`EspRun`](crate::EspRun)), so that
 /// runs killed with their process resume, restored, where the last save
@@ -201,7 +201,7 @@ pub fn lockstep<R: AskTell + Send, E: Evaluator>(
 ///
 /// # Panics
 /// If `evaluators` and `runs` differ in length.
-pub fn lockstep_with<R: AskTell + Send, E: Evaluator>(
+pub fn run_together_with<R: AskTell + Send, E: Evaluator>(
     runs: &mut [R],
     evaluators: &[&E],
     on_record: impl Fn(usize, &GenerationRecord) -> Control + Sync,
