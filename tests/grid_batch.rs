@@ -7,8 +7,8 @@ use std::collections::BTreeSet;
 use std::process::{Command, Stdio};
 
 use common::{assert_same_runs, finished_lines, psa_esp, tiny_grid};
+use psa_experiment::grid::runner::run_seed;
 use psa_experiment::grid::GridSpec;
-use psa_experiment::grid_run::run_seed;
 
 fn args(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()

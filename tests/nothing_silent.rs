@@ -11,8 +11,8 @@ use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use esp_neuroevolution::network::Network;
+use psa_experiment::grid::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_NAME};
 use psa_experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
-use psa_experiment::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_NAME};
 use psa_sim::physics::{BackendKind, StartQuaternion};
 use psa_sim::psa::defaults::{value_at, Placement, BUILDS, CHANGES};
 use psa_sim::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};

@@ -6,25 +6,21 @@
 //! It sits between the simulator and the command line: it may not depend
 //! on the command line (`clap`) or the `psa-esp` binary, and the simulator
 //! may not depend on it. `.ci/run` checks its `cargo tree`.
+//!
+//! Its modules, by concern: [`grid`], the grid and everything that runs it
+//! (its executors, replicate, sweep and rescore, shards and claims for
+//! batch jobs); [`results`], what a run and a grid leave (the results
+//! model, `runs.csv`, the column tables, statistics); [`champion`], the
+//! tests of a run's champion (robustness, the ODE check); [`report`] and
+//! [`plots`]; and at the root the configuration and the single run.
 
-pub mod claim;
-pub mod columns;
+pub mod champion;
 mod config;
 pub mod grid;
-pub mod grid_run;
-pub mod lockstep;
-pub mod ode_check;
 pub mod plots;
-pub mod replicate;
 pub mod report;
-pub mod rescore;
 pub mod results;
-pub mod robustness;
 mod run;
-pub mod runs_table;
-pub mod shard;
-pub mod stats;
-pub mod sweep;
 
 pub use config::{
     paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, BASELINE, PAPER_NOISE_SD, PAPER_NOISY_TRIALS,

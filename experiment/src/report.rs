@@ -24,10 +24,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
-use super::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
-use super::runs_table::{runs_csv, RUNS_CSV};
-use super::GridConfig;
+use crate::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
+use crate::results::runs_table::{runs_csv, RUNS_CSV};
 use crate::results::{load_run, GenerationRow, RunData};
+use crate::GridConfig;
 use psa_sim::psa::Task;
 
 pub use distance::{Distance, Part, Term};

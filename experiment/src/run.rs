@@ -4,9 +4,9 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::{Algorithm, RunConfig};
-use crate::columns::{header, row, Column};
+use crate::results::columns::{header, row, Column};
 use crate::results::EvolveOutcome;
+use crate::{Algorithm, RunConfig};
 use anyhow::{Context, Result};
 use esp_neuroevolution::{Esp, GenerationRecord, HillClimb, LesionOutcome, RunResult};
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};

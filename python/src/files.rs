@@ -7,7 +7,7 @@ use esp_neuroevolution::math::Exponential;
 use esp_neuroevolution::network::Network as Weights;
 use esp_neuroevolution::rng::stream;
 use numpy::{PyArray1, PyArray2};
-use psa_experiment::robustness::TrialSummary;
+use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::RunConfig;
 use psa_sim::psa::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};

@@ -6,8 +6,8 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 
 use super::choice::choice;
+use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::plots::{write_trial_pictures, TrialPicture};
-use psa_experiment::robustness::TrialSummary;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};

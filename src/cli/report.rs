@@ -24,7 +24,7 @@ pub struct ReportArgs {
 /// another configuration (the report is written all the same, without it).
 /// A directory that is not a grid is an error (exit code 2).
 pub fn run(args: ReportArgs) -> Result<i32> {
-    if psa_experiment::sweep::sweep_file(&args.dir).exists() {
+    if psa_experiment::grid::sweep::sweep_file(&args.dir).exists() {
         let (_, markdown, written) = psa_experiment::report::write_sweep_report(&args.dir)?;
         say!("{}", markdown.trim_end());
         for path in written {

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use super::replicate::read_overrides;
+use psa_experiment::grid::rescore::{check_out, check_rescoring_acts, rescore, rescored_spec};
 use psa_experiment::grid::GridSpec;
-use psa_experiment::rescore::{check_out, check_rescoring_acts, rescore, rescored_spec};
 use psa_sim::ode::MAX_THREADS;
 use psa_sim::psa::limits::MAX_TRIALS;
 

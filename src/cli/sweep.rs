@@ -6,7 +6,7 @@ use anyhow::Result;
 
 use super::choice::choice;
 use super::replicate::{report_gpu_share, report_held, GridArgs, Progress};
-use psa_experiment::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
+use psa_experiment::grid::sweep::{parse_vary, sweep, SweepMode, SweepSpec};
 
 /// Arguments of `sweep`.
 #[derive(Debug, clap::Args)]

@@ -21,7 +21,7 @@ use serde::Serialize;
 
 use super::paper::{paper_bursts, paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK, PAPER_TASKS};
 use super::{GridResults, Metric};
-use crate::stats::mean_sd;
+use crate::results::stats::mean_sd;
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
 use psa_sim::psa::Task;

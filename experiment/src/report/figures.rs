@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use super::tables::FigureLink;
 use super::{GenerationRow, GridResults};
 use crate::plots::curves::{write_curve_figure, CurveFigure, Series};
-use crate::stats::mean_sd;
+use crate::results::stats::mean_sd;
 use crate::{Algorithm, GridConfig, Preset};
 use psa_sim::psa::Task;
 

@@ -7,7 +7,7 @@ use super::paper::{
     paper_bursts_per_run, paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_ALL, PAPER_RUNS_PER_TASK, PAPER_TASKS,
 };
 use super::{GridResults, Metric};
-use crate::stats::{mean_sd, welch};
+use crate::results::stats::{mean_sd, welch};
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
 use psa_sim::psa::Task;

@@ -18,8 +18,8 @@ use super::render::num;
 use super::tables::Report;
 use super::{GridResults, Metric};
 use crate::grid::grid_file;
-use crate::runs_table::{sweep_runs_csv, VariantRuns, RUNS_CSV};
-use crate::sweep::{variant_dir, SweepSpec};
+use crate::grid::sweep::{variant_dir, SweepSpec};
+use crate::results::runs_table::{sweep_runs_csv, VariantRuns, RUNS_CSV};
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
 

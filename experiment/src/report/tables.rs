@@ -10,7 +10,7 @@ use super::findings::{findings, Finding};
 use super::paper::{paper_bursts, paper_cell, PaperCell};
 use super::{GridResults, Metric, Problem};
 use crate::grid::{GridPreset, GridSpec, RunStatus};
-use crate::stats::{mean_sd, welch};
+use crate::results::stats::{mean_sd, welch};
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
 use psa_sim::provenance::BuildInfo;

@@ -3,9 +3,9 @@
 use std::path::{Path, PathBuf};
 
 use super::*;
+use crate::champion::robustness::{Robustness, TrialSummary};
 use crate::grid::{GridPreset, GridSpec, FINISHED_MARKER};
 use crate::results::{parse_records, GenerationRow};
-use crate::robustness::{Robustness, TrialSummary};
 use crate::BASELINE;
 use crate::{Preset, RunFiles};
 use esp_neuroevolution::network::Network;

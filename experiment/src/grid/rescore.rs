@@ -9,10 +9,10 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 
-use super::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
-use super::grid_run::{mark_finished, run_seed, score_champion};
-use super::replicate::prepare;
-use super::shard::Shard;
+use crate::grid::replicate::prepare;
+use crate::grid::runner::{mark_finished, run_seed, score_champion};
+use crate::grid::shard::Shard;
+use crate::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
 use crate::RunFiles;
 use psa_sim::evaluator::EvalPath;
 
@@ -43,7 +43,7 @@ pub fn rescored_spec(source: &GridSpec, overlay: &str, trials: Option<usize>) ->
         None => toml::Table::new(),
     };
     let added: toml::Table = toml::from_str(overlay).context("the rescoring settings")?;
-    super::config::merge(&mut table, added);
+    crate::config::merge(&mut table, added);
     let spec = GridSpec {
         rescoring: Some(toml::to_string(&table)?),
         ode_check: false,
@@ -80,7 +80,7 @@ pub fn check_rescoring_acts(dir: &Path, source: &GridSpec, overlay: &str) -> Res
             key.config == config && matches!(judge_run(dir, source, key, Judge::Read), Ok(RunStatus::Finished))
         });
         let run = match finished {
-            Some(key) => super::grid::run_folder_config(&run_dir(dir, &key))?,
+            Some(key) => crate::grid::run_folder_config(&run_dir(dir, &key))?,
             None => source.run_config(config)?,
         };
         let scoring = match &source.rescoring {
@@ -116,7 +116,7 @@ fn check_each_setting_acts(
                 .with_overrides(&alone)
                 .with_context(|| format!("the rescoring setting {alone}"))?;
             for &task in source.tasks.iter().filter(|&&t| config.applies_to(t)) {
-                let tested = |c: &crate::RunConfig| super::robustness::tested_settings(&c.problem, task);
+                let tested = |c: &crate::RunConfig| crate::champion::robustness::tested_settings(&c.problem, task);
                 acts |= tested(before)? != tested(&after)?;
             }
         }

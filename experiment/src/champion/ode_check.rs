@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 
-use super::robustness::{test_robustness, Robustness};
+use crate::champion::robustness::{test_robustness, Robustness};
 use esp_neuroevolution::network::Network;
 use esp_neuroevolution::rng::stream;
 use psa_sim::evaluator::EvalPath;

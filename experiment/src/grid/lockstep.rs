@@ -15,9 +15,9 @@ use std::sync::Mutex;
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 
-use super::grid::{run_dir, GridSpec, RunKey};
-use super::grid_run::{run_seed, test_and_mark, FinishedRun};
-use super::{Algorithm, GridConfig, RunConfig, RunStart};
+use crate::grid::runner::{run_seed, test_and_mark, FinishedRun};
+use crate::grid::{run_dir, GridSpec, RunKey};
+use crate::{Algorithm, GridConfig, RunConfig, RunStart};
 use esp_neuroevolution::together::run_together_with;
 use esp_neuroevolution::{AnyRun, AskTell, Control, Esp, HillClimb};
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
@@ -71,7 +71,7 @@ type CellEvaluator = ((usize, GridConfig, Task), PsaEvaluator);
 /// by index) in lockstep on the current rayon pool, their networks
 /// evaluated on `path`: every grid's runs in one pass. Hands each run's
 /// outcome to `finished` with its grid's index, as
-/// [`crate::grid_run::run_one`] would give it.
+/// [`crate::grid::runner::run_one`] would give it.
 pub(super) fn replicate_lockstep(
     grids: &[(&Path, &GridSpec)],
     todo: &[(usize, RunKey)],

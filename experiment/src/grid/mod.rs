@@ -11,13 +11,26 @@
 //!                                   robustness.json the robustness tests (written last: the run is finished)
 //!                                   claim.json      while a process runs it (see `claim`)
 //! ```
+//!
+//! Beside the folder's model, what runs a grid: [`runner`] (one run: its
+//! evolution, robustness tests and marks), the executors run by run
+//! ([`replicate`]) and in lockstep ([`lockstep`]), [`sweep`] and
+//! [`rescore`], and for batch jobs [`shard`] and [`claim`].
+
+pub mod claim;
+pub mod lockstep;
+pub mod replicate;
+pub mod rescore;
+pub mod runner;
+pub mod shard;
+pub mod sweep;
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use super::{GridConfig, RunConfig, RunFiles};
+use crate::{GridConfig, RunConfig, RunFiles};
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::Task;
 
@@ -85,7 +98,7 @@ pub struct GridSpec {
     pub robustness_trials: usize,
     /// Whether every champion is flown again on `ode` after its run, where
     /// its fitness and robustness results must be bit-identical (grids on
-    /// `native` only; see [`super::ode_check`]). On by default for the
+    /// `native` only; see [`crate::champion::ode_check`]). On by default for the
     /// paper preset on `native`.
     #[serde(default)]
     pub ode_check: bool,
@@ -286,7 +299,7 @@ impl GridSpec {
         }
         if let Some(text) = &self.overrides {
             let overrides: toml::Table = toml::from_str(text).context("the grid's configuration overrides")?;
-            super::config::merge(&mut table, overrides);
+            crate::config::merge(&mut table, overrides);
         }
         let base: RunConfig = table.try_into()?;
         let mut c = config.apply(base);
@@ -602,7 +615,7 @@ fn check_finished_files(folder: &Path, spec: &GridSpec) -> Result<()> {
         psa_sim::io::read_input(&path, "run file")
     };
     let damaged = |name: &str| format!("{}: damaged file", folder.join(name).display());
-    serde_json::from_str::<super::robustness::Robustness>(&read(FINISHED_MARKER)?)
+    serde_json::from_str::<crate::champion::robustness::Robustness>(&read(FINISHED_MARKER)?)
         .with_context(|| damaged(FINISHED_MARKER))?;
     let summary: serde_json::Value =
         serde_json::from_str(&read(RunFiles::SUMMARY)?).with_context(|| damaged(RunFiles::SUMMARY))?;

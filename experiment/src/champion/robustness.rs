@@ -4,7 +4,7 @@
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
-use super::PAPER_NOISE_SD;
+use crate::PAPER_NOISE_SD;
 use esp_neuroevolution::network::Network;
 use esp_neuroevolution::rng::stream;
 use psa_sim::evaluator::{trial_scores, EvalPath};
@@ -27,7 +27,7 @@ pub struct TrialSummary {
 impl TrialSummary {
     /// The summary of `values` (sd 0 for a single value).
     pub fn of(values: &[f64]) -> TrialSummary {
-        let (mean, sd) = super::stats::mean_sd(values);
+        let (mean, sd) = crate::results::stats::mean_sd(values);
         TrialSummary {
             mean,
             sd: if values.len() > 1 { sd } else { 0.0 },

@@ -12,11 +12,11 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Result};
 use rayon::prelude::*;
 
-use super::claim::{claim, Attempt, Claim, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
-use super::grid::{judge_run, run_dir, run_status, GridSpec, Judge, RunKey, RunStatus};
-use super::grid_run::{run_one, FinishedRun};
-use super::lockstep::{replicate_lockstep, Executor};
-use super::shard::Shard;
+use crate::grid::claim::{claim, Attempt, Claim, ClaimRecord, DEFAULT_CLAIM_TIMEOUT};
+use crate::grid::lockstep::{replicate_lockstep, Executor};
+use crate::grid::runner::{run_one, FinishedRun};
+use crate::grid::shard::Shard;
+use crate::grid::{judge_run, run_dir, run_status, GridSpec, Judge, RunKey, RunStatus};
 use psa_sim::evaluator::EvalPath;
 
 /// Something to tell the user while the grid runs.
@@ -88,7 +88,7 @@ pub struct ReplicateSummary {
 /// and how many of its runs are finished.
 pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Result<(Vec<RunKey>, usize)> {
     spec.validate()?;
-    let grid_file = super::grid::grid_file(dir);
+    let grid_file = crate::grid::grid_file(dir);
     // `runs/` first: a grid's run folders appear only after its grid.json.
     if dir.join("runs").exists() && !grid_file.exists() {
         bail!(
@@ -126,8 +126,8 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Resul
         match judge_run(dir, spec, key, judge) {
             Ok(RunStatus::Finished) => {
                 // What a killed process left in a finished run.
-                super::claim::clear_stale(&folder, DEFAULT_CLAIM_TIMEOUT)?;
-                super::lockstep::remove_checkpoint(&folder)?;
+                crate::grid::claim::clear_stale(&folder, DEFAULT_CLAIM_TIMEOUT)?;
+                crate::grid::lockstep::remove_checkpoint(&folder)?;
             }
             Ok(RunStatus::Missing | RunStatus::Unfinished) => todo.push(*key),
             Err(e) => problems.push(format!("{e:#}")),

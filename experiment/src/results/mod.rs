@@ -1,15 +1,21 @@
 //! The results model: what a finished run's files hold, read and written
 //! by the same types. [`EvolveOutcome`] is `run.json`; [`RunData`] is a
 //! finished run as the report and `runs.csv` see it (its `run.json`, its
-//! robustness tests and its `records.csv`).
+//! robustness tests and its `records.csv`). Beside it, [`runs_table`]
+//! (`runs.csv`), [`columns`] (the column tables of the CSV files) and
+//! [`stats`] (Welch's test and the other statistics).
+
+pub mod columns;
+pub mod runs_table;
+pub mod stats;
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
+use crate::champion::robustness::Robustness;
 use crate::grid::{RunKey, FINISHED_MARKER};
-use crate::robustness::Robustness;
 use crate::RunFiles;
 use psa_sim::io::write_atomic;
 use psa_sim::psa::Task;
@@ -48,9 +54,9 @@ pub struct EvolveOutcome {
     /// Wall-clock seconds.
     pub seconds: f64,
     /// The ODE check of a grid run on `native` (see
-    /// [`crate::ode_check`]), added once the check ran.
+    /// [`crate::champion::ode_check`]), added once the check ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ode_check: Option<crate::ode_check::OdeCheck>,
+    pub ode_check: Option<crate::champion::ode_check::OdeCheck>,
 }
 
 impl EvolveOutcome {

@@ -16,9 +16,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use super::grid::GridSpec;
-use super::replicate::{replicate_grids, GridJob, GridProgress, HeldRun, ReplicateOptions};
-use super::RunConfig;
+use crate::grid::replicate::{replicate_grids, GridJob, GridProgress, HeldRun, ReplicateOptions};
+use crate::grid::GridSpec;
+use crate::RunConfig;
 
 /// The `format` of `sweep.json`.
 pub const SWEEP_FORMAT: &str = "psa-esp-sweep";
@@ -457,7 +457,7 @@ fn set_dotted(table: &mut toml::Table, key: &str, value: &str) -> Result<()> {
             .with_context(|| format!("{key}: {part} is a value, not a table"))?;
     }
     match (current.get_mut(last), value) {
-        (Some(toml::Value::Table(existing)), toml::Value::Table(added)) => super::config::merge(existing, added),
+        (Some(toml::Value::Table(existing)), toml::Value::Table(added)) => crate::config::merge(existing, added),
         (_, value) => {
             current.insert(last.to_string(), value);
         }

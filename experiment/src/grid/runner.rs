@@ -1,7 +1,7 @@
 //! One run of a grid: the seed it runs with, the run itself and, once its
 //! evolution is written, its robustness tests and ODE check and the file
 //! that marks it finished. Both executors (run by run in
-//! [`crate::replicate`], all together in [`crate::lockstep`]) run their
+//! [`crate::grid::replicate`], all together in [`crate::grid::lockstep`]) run their
 //! runs through it.
 
 use std::path::Path;
@@ -9,9 +9,9 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use rand::RngExt;
 
+use crate::champion::ode_check::check_on_ode;
+use crate::champion::robustness::{test_robustness, Robustness};
 use crate::grid::{run_dir, GridSpec, RunKey, FINISHED_MARKER};
-use crate::ode_check::check_on_ode;
-use crate::robustness::{test_robustness, Robustness};
 use crate::{run_evolution, EvolveOutcome, RunFiles};
 use psa_sim::evaluator::EvalPath;
 use psa_sim::psa::NetworkFile;
@@ -48,7 +48,7 @@ pub struct FinishedRun {
 /// evaluated on `path`.
 pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey, path: &EvalPath) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
-    crate::lockstep::check_checkpoint(&folder)?;
+    crate::grid::lockstep::check_checkpoint(&folder)?;
     let config = spec.run_config(key.config)?;
     let seed = run_seed(key);
     let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, path, |_| {})
@@ -87,7 +87,7 @@ pub(crate) fn test_and_mark(
     // A checkpoint an earlier lockstep process left (this run ran again
     // from the start, or resumed from it): a finished run holds only its
     // documented files.
-    crate::lockstep::remove_checkpoint(&folder)?;
+    crate::grid::lockstep::remove_checkpoint(&folder)?;
     mark_finished(&folder, &robustness)?;
     Ok(FinishedRun { key: *key, outcome })
 }

@@ -8,8 +8,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use super::grid::run_dir;
-use crate::columns::{csv_field, header, row, Column};
+use crate::grid::run_dir;
+use crate::results::columns::{csv_field, header, row, Column};
 use crate::results::RunData;
 use crate::RunFiles;
 

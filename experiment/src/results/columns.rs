@@ -54,10 +54,10 @@ mod tests {
 
     #[test]
     fn docs_file_formats_lists_every_column_of_records_and_runs_csv() {
-        let docs = include_str!("../../docs/file-formats.md");
+        let docs = include_str!("../../../docs/file-formats.md");
         for (file, table) in [
             (crate::RunFiles::RECORDS, markdown(&crate::run::RECORD_COLUMNS)),
-            ("runs.csv", markdown(&crate::runs_table::RUN_COLUMNS)),
+            ("runs.csv", markdown(&crate::results::runs_table::RUN_COLUMNS)),
         ] {
             assert!(
                 docs.contains(&table),
