@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::{GridConfig, RunConfig, RunFiles};
+use crate::{EvolveOutcome, GridConfig, RunConfig, RunFiles};
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::Task;
 
@@ -511,11 +511,7 @@ pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
 /// defaults: by its `run.json`'s `build`.
 fn folder_placement(folder: &Path) -> psa_sim::psa::defaults::Placement {
     use psa_sim::psa::defaults::Placement;
-    let build = psa_sim::io::read_input_text(&RunFiles::in_dir(folder).summary)
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-        .and_then(|run| run.get("build").cloned());
-    match build {
+    match EvolveOutcome::build_of(&RunFiles::in_dir(folder).summary) {
         Some(serde_json::Value::Object(build)) => Placement::of_json(Some(&build)),
         _ => Placement::Unknown("its run.json, which names its build, is not written (yet)".into()),
     }
@@ -523,11 +519,7 @@ fn folder_placement(folder: &Path) -> psa_sim::psa::defaults::Placement {
 
 /// The build that wrote the run in `folder`, in words.
 fn folder_build(folder: &Path) -> String {
-    let build = psa_sim::io::read_input_text(&RunFiles::in_dir(folder).summary)
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-        .and_then(|run| run.get("build").cloned());
-    match build {
+    match EvolveOutcome::build_of(&RunFiles::in_dir(folder).summary) {
         Some(build) => format!(
             "the run was written by version {} commit {}",
             build.get("tool_version").and_then(|v| v.as_str()).unwrap_or("?"),
@@ -617,10 +609,9 @@ fn check_finished_files(folder: &Path, spec: &GridSpec) -> Result<()> {
     let damaged = |name: &str| format!("{}: damaged file", folder.join(name).display());
     serde_json::from_str::<crate::champion::robustness::Robustness>(&read(FINISHED_MARKER)?)
         .with_context(|| damaged(FINISHED_MARKER))?;
-    let summary: serde_json::Value =
-        serde_json::from_str(&read(RunFiles::SUMMARY)?).with_context(|| damaged(RunFiles::SUMMARY))?;
-    if !summary.get("champion_fitness").is_some_and(|f| f.is_number()) {
-        bail!("{}: no champion_fitness", damaged(RunFiles::SUMMARY));
+    let summary = EvolveOutcome::load(&RunFiles::in_dir(folder).summary)?;
+    if !summary.champion_fitness.is_finite() {
+        bail!("{}: no finite champion_fitness", damaged(RunFiles::SUMMARY));
     }
     psa_sim::psa::NetworkFile::load(&RunFiles::in_dir(folder).champion)?;
     let rows = read(RunFiles::RECORDS)?.lines().count();

@@ -66,6 +66,24 @@ impl EvolveOutcome {
         json.push('\n');
         write_atomic(path, json.as_bytes())
     }
+
+    /// Reads the `run.json` at `path`; fails naming the file where it is
+    /// damaged (it does not parse as this type).
+    pub fn load(path: &Path) -> Result<EvolveOutcome> {
+        let text = psa_sim::io::read_input(path, "run file")?;
+        serde_json::from_str(&text).with_context(|| format!("{}: damaged file", path.display()))
+    }
+
+    /// The `build` of the `run.json` at `path`, whatever build wrote it: a
+    /// file of an earlier build need not parse as this one's type, and
+    /// its `build` is what says which defaults it ran under. `None` where
+    /// the file is missing, damaged or names no build.
+    pub fn build_of(path: &Path) -> Option<serde_json::Value> {
+        psa_sim::io::read_input_text(path)
+            .ok()
+            .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+            .and_then(|run| run.get("build").cloned())
+    }
 }
 
 /// One generation of `records.csv` (the columns the report uses), fitness in %.
@@ -103,9 +121,8 @@ pub fn load_run(folder: &Path, key: &RunKey) -> Result<RunData> {
         let text = psa_sim::io::read_input(&path, "run file")?;
         Ok((path, text))
     };
-    let (path, text) = read(RunFiles::SUMMARY)?;
-    let summary: EvolveOutcome =
-        serde_json::from_str(&text).with_context(|| format!("{}: damaged file", path.display()))?;
+    let path = folder.join(RunFiles::SUMMARY);
+    let summary = EvolveOutcome::load(&path)?;
     if summary.task != key.task || !summary.champion_fitness.is_finite() {
         bail!(
             "{}: task {} and champion fitness {} do not fit the run of task {}",
