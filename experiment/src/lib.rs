@@ -36,8 +36,8 @@ pub fn build_info() -> psa_sim::provenance::BuildInfo {
     psa_sim::provenance::BuildInfo {
         tool_version: env!("CARGO_PKG_VERSION").into(),
         git_commit: env!("PSA_ESP_GIT_COMMIT").into(),
-        libode_version: ode::libode_version().into(),
-        defaults: Some(psa::defaults::rows() as u64),
+        libode_version: psa_sim::ode::libode_version().into(),
+        defaults: Some(psa_sim::psa::defaults::rows() as u64),
     }
 }
 
