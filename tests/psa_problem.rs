@@ -295,7 +295,7 @@ fn start_states_and_targets_are_as_specified() {
         (s2, g2),
         (
             BodyState {
-                omega: 0.75,
+                omega: 1.0,
                 ..BodyState::default()
             },
             Target {

@@ -12,7 +12,7 @@
 //! poles' angles and angular velocities, scaled as ESP 3.0's cart-pole code
 //! scales them (x / 2.4, x' / 10, each angle / 36 degrees, the long pole's
 //! angular velocity / 5 and the short one's / 16, and a bias input of
-//! 0.5); its logistic output o pushes the cart with (o - 0.5) x 20 N,
+//! 0.5, NEAT's value, `--bias`); its logistic output o pushes the cart with (o - 0.5) x 20 N,
 //! never less than 10/256 N either way (the minimum force of ESP's code and
 //! G08). A trial fails when the cart leaves the track or either pole leans
 //! more than 36 degrees; fitness is the number of decisions survived, and a
@@ -84,8 +84,8 @@ fn force(o: f64) -> f64 {
 }
 
 /// Decisions `network` keeps both poles up from the long pole at
-/// `angle` (rad), at most [`STEPS_TO_SOLVE`].
-fn balance(network: &Network, angle: f64) -> u32 {
+/// `angle` (rad), with `bias` as its bias input, at most [`STEPS_TO_SOLVE`].
+fn balance(network: &Network, angle: f64, bias: f64) -> u32 {
     let poles = [LONG_POLE, SHORT_POLE];
     let mut state = [0.0, 0.0, angle, 0.0, 0.0, 0.0];
     let mut output = [0.0];
@@ -101,7 +101,7 @@ fn balance(network: &Network, angle: f64) -> u32 {
             long_spin / 5.0,
             short / THIRTY_SIX_DEGREES,
             short_spin / 16.0,
-            0.5,
+            bias,
         ];
         network.activate(&input, &mut output);
         let push = force(output[0]);
@@ -116,6 +116,7 @@ struct Options {
     seeds: u64,
     budget: u64,
     angle_degrees: f64,
+    bias: f64,
     quiet: bool,
 }
 
@@ -149,7 +150,7 @@ fn preset(name: &str) -> Result<EspSettings, String> {
 }
 
 /// The options that take a value.
-const VALUED: [&str; 12] = [
+const VALUED: [&str; 13] = [
     "--preset",
     "--hidden",
     "--subpop",
@@ -162,6 +163,7 @@ const VALUED: [&str; 12] = [
     "--budget",
     "--seeds",
     "--angle",
+    "--bias",
 ];
 
 /// Parses `--name value` pairs and `--quiet` from the command line.
@@ -250,15 +252,16 @@ fn parse(args: &[String]) -> Result<Options, Box<dyn Error>> {
         seeds: count("--seeds")?.unwrap_or(50) as u64,
         budget: count("--budget")?.unwrap_or(200_000) as u64,
         angle_degrees: number("--angle")?.unwrap_or(4.5),
+        bias: number("--bias")?.unwrap_or(0.5),
         quiet,
     })
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
     let options = options()?;
-    let angle = options.angle_degrees.to_radians();
+    let (angle, bias) = (options.angle_degrees.to_radians(), options.bias);
     let evaluator = FnEvaluator::new(7, 1, move |network: &Network, _: &mut Stream| {
-        Ok(f64::from(balance(network, angle)))
+        Ok(f64::from(balance(network, angle, bias)))
     });
     let s = &options.settings;
     let outcomes = solve::solve(
@@ -303,6 +306,8 @@ mod tests {
         assert_eq!(o.settings.stagnation_min_improvement, 0.5);
         assert_eq!(o.settings.trials_per_neuron, 2);
         assert!(o.quiet);
+        assert_eq!(o.bias, 0.5);
+        assert_eq!(parse(&args("--bias 1")).unwrap().bias, 1.0);
         for (bad, needle) in [
             ("--stagnaton 50", "--stagnaton"),
             ("--stagnation", "needs a value"),

@@ -446,6 +446,9 @@ mod tests {
     #[test]
     fn each_rate_is_annealed_by_its_own_constant() {
         let settings = HillClimbSettings {
+            p_noise: 0.2,
+            alpha: 1.0,
+            p_flip: 0.05,
             anneal_noise: 0.9,
             anneal_alpha: 0.5,
             anneal_flip: 0.99,

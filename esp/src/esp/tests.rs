@@ -344,7 +344,14 @@ fn lesion_test_removes_a_redundant_neuron_and_adds_otherwise() {
     );
 }
 
-fn run_states(settings: EspSettings, generations: usize) -> Vec<(usize, Option<usize>, Option<LesionOutcome>)> {
+/// What `read` takes from each of `generations` generations of `settings`
+/// (small populations, b = 3) on a problem that never improves after its
+/// first generation.
+fn small_run<T>(
+    settings: EspSettings,
+    generations: usize,
+    mut read: impl FnMut(GenerationRecord, &State) -> T,
+) -> Vec<T> {
     let e = esp(EspSettings {
         subpop_size: 8,
         trials_per_neuron: 2,
@@ -355,10 +362,16 @@ fn run_states(settings: EspSettings, generations: usize) -> Vec<(usize, Option<u
     let eval = all_neurons_needed();
     (1..=generations)
         .map(|g| {
-            let r = e.generation(&eval, &mut st, g).unwrap();
-            (st.subpops.len(), st.best.as_ref().map(|(b, _)| b.hidden()), r.lesion)
+            let record = e.generation(&eval, &mut st, g).unwrap();
+            read(record, &st)
         })
         .collect()
+}
+
+fn run_states(settings: EspSettings, generations: usize) -> Vec<(usize, Option<usize>, Option<LesionOutcome>)> {
+    small_run(settings, generations, |r, st| {
+        (st.subpops.len(), st.best.as_ref().map(|(b, _)| b.hidden()), r.lesion)
+    })
 }
 
 #[test]
@@ -417,23 +430,9 @@ fn erase_best_forgets_the_best_on_a_topology_change_but_keeps_the_champion() {
     assert!(saw_erase);
 }
 
-/// Records of `generations` generations of `settings` (small populations,
-/// b = 3) on a problem that never improves after its first generation.
+/// Records of [`small_run`], with the erased bar after each generation.
 fn records_of(settings: EspSettings, generations: usize) -> Vec<(GenerationRecord, Option<f64>)> {
-    let e = esp(EspSettings {
-        subpop_size: 8,
-        trials_per_neuron: 2,
-        stagnation: 3,
-        ..settings
-    });
-    let mut st = state(&e, 5);
-    let eval = all_neurons_needed();
-    (1..=generations)
-        .map(|g| {
-            let record = e.generation(&eval, &mut st, g).unwrap();
-            (record, st.erased)
-        })
-        .collect()
+    small_run(settings, generations, |record, st| (record, st.erased))
 }
 
 /// The records of [`records_of`] as text, to compare two runs whole.

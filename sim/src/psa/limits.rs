@@ -47,8 +47,7 @@ const SPEED: [f64; 2] = [-10.0, 10.0];
 const SPEED_WHY: &str = "the tasks start at up to 0.4 m/s, the fastest flight mode of NASA's Astrobee; 1 N thrusters on a 3 kg body give 0.7 m/s^2";
 /// Angular velocities (rad/s).
 const SPIN: [f64; 2] = [-100.0, 100.0];
-const SPIN_WHY: &str =
-    "the start spins fitted to the paper are about 1 rad/s; 100 rad/s is 16 turns a second";
+const SPIN_WHY: &str = "the start spins fitted to the paper are about 1 rad/s; 100 rad/s is 16 turns a second";
 /// Input scalings (input units per SI unit) and the bias input.
 const SCALE: [f64; 2] = [-1000.0, 1000.0];
 const SCALE_WHY: &str =
