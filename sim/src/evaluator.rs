@@ -156,7 +156,7 @@ enum Route {
     /// One network at a time, each worker with its own [`TrialRunner`].
     Scalar,
     /// `native`'s batched path, the runner shared by every worker thread.
-    Batched(BatchRunner),
+    Batched(Box<BatchRunner>),
     /// `ode`'s lockstep path, each worker with its own world.
     OdeLockstep,
     /// The cuda kernel's flier (a GPU, or the host build), on `native`.
@@ -201,7 +201,7 @@ impl PsaEvaluator {
         };
         let route = match path {
             EvalPath::Scalar => Route::Scalar,
-            EvalPath::Simd(level) => Route::Batched(BatchRunner::new(&settings, task)?.with_level(*level)),
+            EvalPath::Simd(level) => Route::Batched(Box::new(BatchRunner::new(&settings, task)?.with_level(*level))),
             EvalPath::OdeLockstep => {
                 OdeLockstepRunner::new(&settings, task)?;
                 Route::OdeLockstep
@@ -209,7 +209,7 @@ impl PsaEvaluator {
             EvalPath::KernelOnHost => kernel(Arc::new(HostTrials))?,
             EvalPath::Kernel(flier) => kernel(flier.clone())?,
             EvalPath::Fastest => match settings.backend {
-                BackendKind::Native => Route::Batched(BatchRunner::new(&settings, task)?),
+                BackendKind::Native => Route::Batched(Box::new(BatchRunner::new(&settings, task)?)),
                 BackendKind::Ode if OdeLockstepRunner::supports(&settings) => Route::OdeLockstep,
                 BackendKind::Ode | BackendKind::Rapier => Route::Scalar,
             },
