@@ -112,7 +112,7 @@ pub(crate) fn score_champion(
             .with_context(|| format!("configuration {} with the grid's rescoring", key.config))?,
         None => run,
     };
-    let (_, champion) = NetworkFile::load(&RunFiles::in_dir(&folder).champion)?;
+    let (_, champion) = NetworkFile::load(&RunFiles::in_dir(folder).champion)?;
     let mut robustness = test_robustness(
         &champion,
         key.task,
