@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 use esp_neuroevolution::network::Network;
 use psa_experiment::grid::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_NAME};
 use psa_experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
+use psa_experiment::RunFiles;
 use psa_sim::physics::{BackendKind, StartQuaternion};
 use psa_sim::psa::defaults::{value_at, Placement, BUILDS, CHANGES};
 use psa_sim::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};
@@ -373,6 +374,51 @@ fn a_champion_of_each_earlier_model_replays_to_its_recorded_fitness_bit_for_bit_
 
 // 3. Settings that do nothing act or are refused.
 
+/// The arguments of a tiny sweep (baseline, one seed, three robustness
+/// trials, one thread) on `tasks` into `out`, varying each of `vary`.
+fn tiny_sweep<'a>(out: &'a Path, tasks: &'a str, vary: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "sweep",
+        "--preset",
+        "quick",
+        "--configs",
+        "baseline",
+        "--tasks",
+        tasks,
+        "--seeds",
+        "1",
+        "--robustness-trials",
+        "3",
+        "--threads",
+        "1",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    for v in vary {
+        args.extend(["--vary", v]);
+    }
+    args
+}
+
+/// Every file called `name` under `dir`, sorted.
+fn files_named(dir: &Path, name: &str) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).into_iter().flatten() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.file_name().is_some_and(|n| n == name) {
+                found.push(path);
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
 fn grid(configs: &[&str], tasks: &[Task]) -> GridSpec {
     GridSpec {
         configs: configs.iter().map(|c| c.parse().unwrap()).collect(),
@@ -409,6 +455,21 @@ fn a_varied_backend_or_generation_count_is_the_variant_grids_own() {
         .map(|v| spec.variant_grid(v).unwrap().generations)
         .collect();
     assert_eq!(generations, [3, 4]);
+    // Through the command line: each variant's runs evolve for its own
+    // number of generations.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    ok(&psa_esp(&tiny_sweep(&out, "1", &["esp.generations=3,4"])));
+    let lines: Vec<usize> = files_named(&out, RunFiles::RECORDS)
+        .iter()
+        .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
+        .collect();
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    assert_eq!(
+        lines[1],
+        lines[0] + 1,
+        "4 generations record one more than 3: {lines:?}"
+    );
     // In a grid's own settings they are refused: the grid sets them.
     let mut own = grid(&["baseline"], &[Task::StopRotation]);
     own.overrides = Some("[problem]\nbackend = \"ode\"\n".into());
@@ -443,6 +504,27 @@ fn a_varied_setting_that_changes_no_run_is_refused_naming_it() {
     .unwrap_err();
     let err = format!("{err:#}");
     assert!(err.contains("problem.fitness") && err.contains("overlap"), "{err}");
+    // The command line refuses them before anything is written.
+    let dir = tempfile::tempdir().unwrap();
+    for (vary, needles) in [
+        (
+            "problem.tasks.task1_spin=1,1.0",
+            ["problem.tasks.task1_spin", "same value"],
+        ),
+        (
+            "problem.noise.input_sd=0.0,0.1",
+            ["problem.noise.input_sd", "changes nothing"],
+        ),
+    ] {
+        let out = dir.path().join("sweep");
+        let mut args = tiny_sweep(&out, "1", &[vary]);
+        if vary.starts_with("problem.noise") {
+            let at = args.iter().position(|a| *a == "baseline").unwrap();
+            args[at] = "input-noise";
+        }
+        refused(&psa_esp(&args), &needles);
+        assert!(!out.exists(), "{vary}: nothing written");
+    }
 }
 
 #[test]
@@ -557,6 +639,13 @@ fn a_sweep_of_too_many_variants_is_refused_before_any_is_built() {
     let err = format!("{err:#}");
     assert!(err.contains("100000000 variants"), "{err}");
     assert!(start.elapsed() < Duration::from_secs(5), "{:?}", start.elapsed());
+    // The command line, likewise: refused at once, nothing written.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let vary: Vec<&str> = vary.iter().map(String::as_str).collect();
+    let o = run_within(&tiny_sweep(&out, "1", &vary), Duration::from_secs(30)).expect("refused within 30 s");
+    refused(&o, &["100000000 variants"]);
+    assert!(!out.exists());
 }
 
 // 6. One run counted once.
@@ -694,22 +783,22 @@ fn a_run_resumed_without_lockstep_leaves_no_checkpoint() {
 
 // 9. Sweeps are checked whole before the first run.
 
+/// Eight keys of two values each: 256 variants, whose names would pass a
+/// file name's 255 bytes if each named every key and value in full.
+const VARIED: [&str; 8] = [
+    "problem.tasks.task3_random_distance=[0.25,0.55],[0.3,0.5]",
+    "problem.tasks.task2_velocity=[0.0,0.0],[0.1,0.0]",
+    "problem.sensors.angular_velocity_scale=1.0,2.0",
+    "problem.sensors.position_scale=10.0,20.0",
+    "problem.fitness.heading_window=0.05,0.1",
+    "problem.fitness.box_half_width=0.05,0.1",
+    "problem.tasks.task3_target_heading=0.0,0.5",
+    "problem.tasks.task2_target_heading=1.5707963267948966,1.0",
+];
+
 #[test]
 fn variant_names_fit_a_file_system_and_every_variant_is_checked_on_every_task() {
-    let spec = sweep_of(
-        grid(&["baseline"], &[Task::StopRotation]),
-        &[
-            "problem.tasks.task3_random_distance=[0.25,0.55],[0.3,0.5]",
-            "problem.tasks.task2_velocity=[0.0,0.0],[0.1,0.0]",
-            "problem.sensors.angular_velocity_scale=1.0,2.0",
-            "problem.sensors.position_scale=10.0,20.0",
-            "problem.fitness.heading_window=0.05,0.1",
-            "problem.fitness.box_half_width=0.05,0.1",
-            "problem.tasks.task3_target_heading=0.0,0.5",
-            "problem.tasks.task2_target_heading=1.5707963267948966,1.0",
-        ],
-    )
-    .unwrap();
+    let spec = sweep_of(grid(&["baseline"], &[Task::StopRotation]), &VARIED).unwrap();
     let variants = spec.variants();
     assert_eq!(variants.len(), 256);
     for v in &variants {
@@ -717,6 +806,21 @@ fn variant_names_fit_a_file_system_and_every_variant_is_checked_on_every_task() 
     }
     let names: std::collections::HashSet<&str> = variants.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(names.len(), variants.len(), "names stay distinct");
+    // The command line makes such a variant's folder: the first of the
+    // 256 runs (shard 0 of 256), three generations.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let mut args = tiny_sweep(&out, "1", &VARIED);
+    args.extend(["--generations", "3", "--shard", "0/256"]);
+    ok(&psa_esp(&args));
+    assert_eq!(files_named(&out, RunFiles::CHAMPION).len(), 1);
+    // Random starts on task 2, through the command line: refused before
+    // any run, nothing written.
+    let out = dir.path().join("random");
+    let mut args = tiny_sweep(&out, "2", &["problem.random_init=true,false"]);
+    args.extend(["--generations", "3"]);
+    refused(&psa_esp(&args), &["task 2", "random"]);
+    assert!(files_named(&out, RunFiles::RECORDS).is_empty());
     // Random starts on task 2: refused before any run.
     let err = sweep_of(grid(&["baseline"], &[Task::Turn]), &["problem.random_init=true,false"]).unwrap_err();
     let err = format!("{err:#}");
@@ -744,6 +848,18 @@ fn a_bad_value_in_a_network_file_is_named_by_its_key() {
     json["problem"]["exponential"] = "slow".into();
     let err = load_json(dir.path(), &json).unwrap_err();
     assert!(err.contains("problem.exponential"), "{err}");
+    // Replayed from the command line, the error names the key too.
+    let mut json = network_json(&PsaSettings::default());
+    json["problem"]["sensors"]["heading_wrap"] = "both".into();
+    let file = dir.path().join("bad.json");
+    std::fs::write(&file, json.to_string()).unwrap();
+    let o = psa_esp(&["replay", file.to_str().unwrap(), "--backend", "native"]);
+    assert!(!o.status.success());
+    let text = stderr(&o);
+    assert!(
+        text.contains("problem.sensors.heading_wrap") && !text.contains("panicked"),
+        "{text}"
+    );
 }
 
 // The rules of docs/limits.md for output paths and checkpoints.
