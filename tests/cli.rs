@@ -170,6 +170,41 @@ fn bench_prints_ns_per_step_for_every_backend_and_the_logistic_share() {
         .all(|e| e["ns_per_network_step_1_thread"].as_f64().unwrap() > 0.0));
 }
 
+#[test]
+fn bench_speedup_floor_exits_0_at_or_above_the_floor_and_1_below_it() {
+    let run = |floor: &str| {
+        psa_esp(&[
+            "bench",
+            "--speedup-floor",
+            floor,
+            "--networks",
+            "16",
+            "--rounds",
+            "3",
+            "--json",
+        ])
+    };
+    let low = run("0.01");
+    assert_eq!(low.status.code(), Some(0), "{}", stderr(&low));
+    let report: serde_json::Value = serde_json::from_str(&stdout(&low)).unwrap();
+    let speedup = report["speedup"].as_f64().unwrap();
+    assert!(speedup > 0.0 && speedup.is_finite(), "{report}");
+    assert_eq!(report["passed"], true, "{report}");
+    let high = run("1000");
+    assert_eq!(high.status.code(), Some(1), "{}", stderr(&high));
+    let report: serde_json::Value = serde_json::from_str(&stdout(&high)).unwrap();
+    assert_eq!(report["passed"], false, "{report}");
+    // What the check cannot honour is refused.
+    for args in [
+        &["bench", "--speedup-floor", "0"][..],
+        &["bench", "--speedup-floor", "4", "--steps", "1000"],
+        &["bench", "--speedup-level", "portable"],
+    ] {
+        let o = psa_esp(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+    }
+}
+
 /// A hand-made 7-3-4 spin damper: neuron 0 fires thrusters 2 and 3
 /// (clockwise torque) when omega > 0, neuron 1 fires 0 and 1 when omega < 0,
 /// neuron 2 is a constant that keeps every output near 0 otherwise.

@@ -58,6 +58,23 @@ pub struct BenchArgs {
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Only check that the batched path's speed-up over the scalar path
+    /// (`native`, 1 thread, --networks networks, --rounds interleaved
+    /// rounds) reaches RATIO, and exit 1 when it does not: CI's guard
+    /// against a build whose batched path falls back to slow code.
+    #[arg(long, value_name = "RATIO",
+          conflicts_with_all = ["steps", "generations", "kernel_networks", "kernel_host", "kernel_only"])]
+    pub speedup_floor: Option<f64>,
+    /// The SIMD level --speedup-floor times (default: the CPU's best).
+    #[arg(long, requires = "speedup_floor", value_parser = simd_level_parser())]
+    pub speedup_level: Option<SimdLevel>,
+}
+
+/// The parser of `--speedup-level`: one of [`SimdLevel::ALL`]'s names.
+fn simd_level_parser() -> impl clap::builder::TypedValueParser<Value = SimdLevel> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(SimdLevel::ALL.map(SimdLevel::name))
+        .map(|name| name.parse().expect("clap admits only the names"))
 }
 
 /// A way of evaluating networks: a backend and the [`EvalPath`] on it (on
@@ -305,6 +322,9 @@ fn time_steps(backend: &mut dyn PhysicsBackend, commands: &[Vec<f64>], steps: u6
 
 /// Runs `bench`.
 pub fn run(args: BenchArgs) -> Result<i32> {
+    if let Some(floor) = args.speedup_floor {
+        return super::bench_floor::run(floor, args.speedup_level, args.networks, args.rounds, args.json);
+    }
     if args.kernel_only {
         let kernel = kernel_rows(&args.kernel_networks, args.rounds, args.kernel_host)?;
         if args.json {

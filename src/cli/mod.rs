@@ -10,6 +10,7 @@ macro_rules! say {
 
 mod backend;
 pub mod bench;
+pub mod bench_floor;
 pub mod bench_kernel;
 pub mod bench_networks;
 pub mod bench_ode;
