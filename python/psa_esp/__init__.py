@@ -13,7 +13,8 @@ search crate ``esp-neuroevolution``), giving the same bits as the
   fitness function of your own (:meth:`Run.optimize`), and saves and
   resumes through the crate's serde;
 - :class:`Network`, :func:`load_network` and :func:`replay` read, write
-  and fly network files in the CLI's format.
+  and fly network files in the CLI's format;
+- :func:`welch` is the report's Welch t-test, for comparisons of your own.
 
 A network's weights are laid out as in a network file: hidden neuron
 after hidden neuron, each its 7 input weights (bias last), then its 4
@@ -43,6 +44,7 @@ from ._native import (
     load_network,
     replay,
     resolve_config,
+    welch,
 )
 from .errors import *  # noqa: F401,F403
 

@@ -19,6 +19,7 @@ from ._native import (
     load_network as load_network,
     replay as replay,
     resolve_config as resolve_config,
+    welch as welch,
 )
 from .errors import *
 

@@ -218,3 +218,8 @@ class Trial:
     def state(self) -> list[float]: ...
     @property
     def target(self) -> list[float]: ...
+
+def welch(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float]:
+    """Welch's two-sample, two-tailed t-test of ``a`` against ``b``, as
+    ``psa-esp report`` computes it: ``(t, df, p)``; NaN for all three where
+    either sample has fewer than 2 values."""

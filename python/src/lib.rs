@@ -20,6 +20,7 @@ mod evaluate;
 mod files;
 mod records;
 mod run;
+mod stats;
 mod trial;
 mod weights;
 
@@ -31,6 +32,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(config::resolve_config, m)?)?;
     m.add_function(wrap_pyfunction!(files::load_network, m)?)?;
     m.add_function(wrap_pyfunction!(files::replay, m)?)?;
+    m.add_function(wrap_pyfunction!(stats::welch, m)?)?;
     m.add_class::<files::Network>()?;
     m.add_class::<run::Run>()?;
     m.add_class::<run::Asked>()?;
