@@ -9,6 +9,6 @@ use pyo3::prelude::*;
 /// for all three.
 #[pyfunction]
 pub fn welch(a: Vec<f64>, b: Vec<f64>) -> (f64, f64, f64) {
-    let w = psa_experiment::stats::welch(&a, &b);
+    let w = psa_experiment::results::stats::welch(&a, &b);
     (w.t, w.df, w.p)
 }
