@@ -54,7 +54,7 @@ pub fn check(floor: f64, level: Option<SimdLevel>, networks: u64, rounds: u64) -
     let pool = psa_sim::ode::thread_pool(1)?;
     let rate = |evaluator: &PsaEvaluator, round: u64| -> Result<f64> {
         let start = Instant::now();
-        pool.install(|| evaluate_all(evaluator, &networks, round, &[]))?;
+        pool.install(|| evaluate_all(evaluator, networks.as_slice(), round, &[]))?;
         Ok(networks.len() as f64 / start.elapsed().as_secs_f64())
     };
     let (mut scalar_rates, mut batched_rates, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
