@@ -16,6 +16,7 @@ use super::EXIT_CHECK_FAILED;
 use esp_neuroevolution::evaluate_all;
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
 use psa_sim::numeric::SimdLevel;
+use psa_sim::physics::BackendKind;
 use psa_sim::psa::{PsaSettings, Task};
 
 /// What the check measured.
@@ -47,7 +48,11 @@ pub fn check(floor: f64, level: Option<SimdLevel>, networks: u64, rounds: u64) -
     if !level.is_supported() {
         bail!("--speedup-level {}: this CPU does not support it", level.name());
     }
-    let evaluator = |path: EvalPath| PsaEvaluator::new(PsaSettings::default(), Task::StopRotation, &path);
+    let settings = PsaSettings {
+        backend: BackendKind::Native,
+        ..PsaSettings::default()
+    };
+    let evaluator = |path: EvalPath| PsaEvaluator::new(settings.clone(), Task::StopRotation, &path);
     let scalar = evaluator(EvalPath::Scalar)?;
     let batched = evaluator(EvalPath::Simd(level))?;
     let networks = random_networks(networks)?;
