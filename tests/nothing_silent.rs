@@ -372,6 +372,51 @@ fn a_champion_of_each_earlier_model_replays_to_its_recorded_fitness_bit_for_bit_
     }
 }
 
+/// The model before the refit (`configs/positive-heading.toml`): its build
+/// wrote every problem setting and the size of its table of defaults,
+/// three rows short of today's (the refit's task-2 spin and the
+/// hill-climber's two alpha rows).
+const POSITIVE_HEADING_ROWS: usize = 3;
+
+#[test]
+fn a_task_2_champion_of_the_model_before_the_refit_replays_to_its_recorded_fitness_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    ok(&psa_esp(&[
+        "evolve",
+        "--task",
+        "2",
+        "--generations",
+        "2",
+        "--backend",
+        "native",
+        "--config",
+        repo("configs/positive-heading.toml").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let recorded = run["champion_fitness"].as_f64().unwrap();
+    let mut old: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("champion.json")).unwrap()).unwrap();
+    assert_eq!(old["problem"]["tasks"]["task2_spin"], 0.75, "the model's own start");
+    old["provenance"]["defaults"] = (psa_sim::psa::defaults::rows() - POSITIVE_HEADING_ROWS).into();
+    let champion = dir.path().join("old.json");
+    std::fs::write(&champion, old.to_string()).unwrap();
+    let replay = ok(&psa_esp(&[
+        "replay",
+        champion.to_str().unwrap(),
+        "--backend",
+        "native",
+        "--json",
+        "--out",
+        dir.path().join("replay").to_str().unwrap(),
+    ]));
+    let json: serde_json::Value = serde_json::from_str(&replay).unwrap();
+    let replayed = json["fitness_percent_mean"].as_f64().unwrap();
+    assert_eq!(replayed.to_bits(), recorded.to_bits(), "{replayed} against {recorded}");
+}
+
 // 3. Settings that do nothing act or are refused.
 
 /// The arguments of a tiny sweep (baseline, one seed, three robustness
