@@ -325,45 +325,59 @@ fn the_table_of_defaults_gives_each_earlier_model_of_configs_its_values() {
     }
 }
 
+/// Evolves a 2-generation champion of `task` on the model of `config` into
+/// `dir/name`: its recorded fitness and its champion file's JSON.
+fn champion_of(dir: &Path, name: &str, config: &str, task: &str) -> (f64, serde_json::Value) {
+    let out = dir.join(name);
+    ok(&psa_esp(&[
+        "evolve",
+        "--task",
+        task,
+        "--generations",
+        "2",
+        "--backend",
+        "native",
+        "--config",
+        repo(config).to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let read = |file: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join(file)).unwrap()).unwrap()
+    };
+    (
+        read("run.json")["champion_fitness"].as_f64().unwrap(),
+        read("champion.json"),
+    )
+}
+
+/// The fitness `psa-esp replay` prints for the network file `json`,
+/// written into `dir/name.json`.
+fn replayed(dir: &Path, name: &str, json: &serde_json::Value) -> f64 {
+    let champion = dir.join(format!("{name}.json"));
+    std::fs::write(&champion, json.to_string()).unwrap();
+    let replay = ok(&psa_esp(&[
+        "replay",
+        champion.to_str().unwrap(),
+        "--backend",
+        "native",
+        "--json",
+        "--out",
+        dir.join(format!("{name}-replay")).to_str().unwrap(),
+    ]));
+    let printed: serde_json::Value = serde_json::from_str(&replay).unwrap();
+    printed["fitness_percent_mean"].as_f64().unwrap()
+}
+
 #[test]
 fn a_champion_of_each_earlier_model_replays_to_its_recorded_fitness_bit_for_bit_as_an_old_file() {
     let dir = tempfile::tempdir().unwrap();
     for (i, (config, changed)) in MODELS.iter().enumerate() {
-        let out = dir.path().join(format!("run{i}"));
-        ok(&psa_esp(&[
-            "evolve",
-            "--task",
-            "1",
-            "--generations",
-            "2",
-            "--backend",
-            "native",
-            "--config",
-            repo(config).to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]));
-        let run: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
-        let recorded = run["champion_fitness"].as_f64().unwrap();
+        let (recorded, mut old) = champion_of(dir.path(), &format!("run{i}"), config, "1");
         // The champion as the build of its model would have written it:
         // none of the settings that build did not have yet.
-        let mut old: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("champion.json")).unwrap()).unwrap();
         as_file_of(&mut old, &parent_of(changed));
-        let champion = dir.path().join(format!("old{i}.json"));
-        std::fs::write(&champion, old.to_string()).unwrap();
-        let replay = ok(&psa_esp(&[
-            "replay",
-            champion.to_str().unwrap(),
-            "--backend",
-            "native",
-            "--json",
-            "--out",
-            dir.path().join(format!("replay{i}")).to_str().unwrap(),
-        ]));
-        let json: serde_json::Value = serde_json::from_str(&replay).unwrap();
-        let replayed = json["fitness_percent_mean"].as_f64().unwrap();
+        let replayed = replayed(dir.path(), &format!("old{i}"), &old);
         assert_eq!(
             replayed.to_bits(),
             recorded.to_bits(),
@@ -381,39 +395,10 @@ const POSITIVE_HEADING_ROWS: usize = 3;
 #[test]
 fn a_task_2_champion_of_the_model_before_the_refit_replays_to_its_recorded_fitness_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("run");
-    ok(&psa_esp(&[
-        "evolve",
-        "--task",
-        "2",
-        "--generations",
-        "2",
-        "--backend",
-        "native",
-        "--config",
-        repo("configs/positive-heading.toml").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]));
-    let run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
-    let recorded = run["champion_fitness"].as_f64().unwrap();
-    let mut old: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("champion.json")).unwrap()).unwrap();
+    let (recorded, mut old) = champion_of(dir.path(), "run", "configs/positive-heading.toml", "2");
     assert_eq!(old["problem"]["tasks"]["task2_spin"], 0.75, "the model's own start");
     old["provenance"]["defaults"] = (psa_sim::psa::defaults::rows() - POSITIVE_HEADING_ROWS).into();
-    let champion = dir.path().join("old.json");
-    std::fs::write(&champion, old.to_string()).unwrap();
-    let replay = ok(&psa_esp(&[
-        "replay",
-        champion.to_str().unwrap(),
-        "--backend",
-        "native",
-        "--json",
-        "--out",
-        dir.path().join("replay").to_str().unwrap(),
-    ]));
-    let json: serde_json::Value = serde_json::from_str(&replay).unwrap();
-    let replayed = json["fitness_percent_mean"].as_f64().unwrap();
+    let replayed = replayed(dir.path(), "old", &old);
     assert_eq!(replayed.to_bits(), recorded.to_bits(), "{replayed} against {recorded}");
 }
 
