@@ -100,7 +100,7 @@ fn finished_grid() -> &'static Path {
     path
 }
 
-fn tiny_args(out: &Path) -> Vec<&str> {
+fn tiny_args(out: &Path) -> Vec<&'static str> {
     let out = Box::leak(out.display().to_string().into_boxed_str());
     vec![
         "replicate",
@@ -404,27 +404,13 @@ fn a_task_2_champion_of_the_model_before_the_refit_replays_to_its_recorded_fitne
 
 // 3. Settings that do nothing act or are refused.
 
-/// The arguments of a tiny sweep (baseline, one seed, three robustness
-/// trials, one thread) on `tasks` into `out`, varying each of `vary`.
-fn tiny_sweep<'a>(out: &'a Path, tasks: &'a str, vary: &[&'a str]) -> Vec<&'a str> {
-    let mut args = vec![
-        "sweep",
-        "--preset",
-        "quick",
-        "--configs",
-        "baseline",
-        "--tasks",
-        tasks,
-        "--seeds",
-        "1",
-        "--robustness-trials",
-        "3",
-        "--threads",
-        "1",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ];
+/// The arguments of a tiny sweep on `tasks` into `out`, varying each of
+/// `vary`: the tiny grid's (`tiny_args`) as a sweep.
+fn tiny_sweep<'a>(out: &Path, tasks: &'a str, vary: &[&'a str]) -> Vec<&'a str> {
+    let mut args = tiny_args(out);
+    args[0] = "sweep";
+    let at = args.iter().position(|a| *a == "--tasks").unwrap();
+    args[at + 1] = tasks;
     for v in vary {
         args.extend(["--vary", v]);
     }
@@ -489,7 +475,10 @@ fn a_varied_backend_or_generation_count_is_the_variant_grids_own() {
     // number of generations.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("sweep");
-    ok(&psa_esp(&tiny_sweep(&out, "1", &["esp.generations=3,4"])));
+    let mut args = tiny_sweep(&out, "1", &["esp.generations=3,4"]);
+    let at = args.iter().position(|a| *a == "--generations").unwrap();
+    args.drain(at..at + 2);
+    ok(&psa_esp(&args));
     let lines: Vec<usize> = files_named(&out, RunFiles::RECORDS)
         .iter()
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
@@ -841,15 +830,16 @@ fn variant_names_fit_a_file_system_and_every_variant_is_checked_on_every_task() 
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("sweep");
     let mut args = tiny_sweep(&out, "1", &VARIED);
-    args.extend(["--generations", "3", "--shard", "0/256"]);
+    args.extend(["--shard", "0/256"]);
     ok(&psa_esp(&args));
     assert_eq!(files_named(&out, RunFiles::CHAMPION).len(), 1);
     // Random starts on task 2, through the command line: refused before
     // any run, nothing written.
     let out = dir.path().join("random");
-    let mut args = tiny_sweep(&out, "2", &["problem.random_init=true,false"]);
-    args.extend(["--generations", "3"]);
-    refused(&psa_esp(&args), &["task 2", "random"]);
+    refused(
+        &psa_esp(&tiny_sweep(&out, "2", &["problem.random_init=true,false"])),
+        &["task 2", "random"],
+    );
     assert!(files_named(&out, RunFiles::RECORDS).is_empty());
     // Random starts on task 2: refused before any run.
     let err = sweep_of(grid(&["baseline"], &[Task::Turn]), &["problem.random_init=true,false"]).unwrap_err();
