@@ -4,19 +4,16 @@
 //! and sweeps end to end.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use esp_neuroevolution::network::Network;
 use esp_neuroevolution::rng::stream;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::{PsaSettings, Task, TrialRunner};
 
-fn psa_esp(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_psa-esp"))
-        .args(args)
-        .output()
-        .expect("run psa-esp")
-}
+mod common;
+
+use common::psa_esp;
 
 fn ok(o: &Output) -> String {
     assert!(
@@ -215,21 +212,7 @@ fn replay_flies_a_champion_on_the_model_it_was_evolved_under() {
     let run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     let evolved = run["champion_fitness"].as_f64().unwrap();
     let champion = out.join("champion.json");
-    let replay = |extra: &[&str]| -> f64 {
-        let mut args = vec![
-            "replay",
-            champion.to_str().unwrap(),
-            "--backend",
-            "native",
-            "--json",
-            "--out",
-        ];
-        let pictures = dir.path().join("replay");
-        args.push(pictures.to_str().unwrap());
-        args.extend(extra);
-        let json: serde_json::Value = serde_json::from_str(&ok(&psa_esp(&args))).unwrap();
-        json["fitness_percent_mean"].as_f64().unwrap()
-    };
+    let replay = |extra: &[&str]| common::replayed_fitness(&champion, &dir.path().join("replay"), extra);
     assert_eq!(replay(&[]), evolved, "the recorded model gives the evolved fitness");
     let on_default = replay(&["--default-model"]);
     assert_ne!(on_default, evolved, "the default model is another model");

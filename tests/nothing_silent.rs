@@ -356,17 +356,7 @@ fn champion_of(dir: &Path, name: &str, config: &str, task: &str) -> (f64, serde_
 fn replayed(dir: &Path, name: &str, json: &serde_json::Value) -> f64 {
     let champion = dir.join(format!("{name}.json"));
     std::fs::write(&champion, json.to_string()).unwrap();
-    let replay = ok(&psa_esp(&[
-        "replay",
-        champion.to_str().unwrap(),
-        "--backend",
-        "native",
-        "--json",
-        "--out",
-        dir.join(format!("{name}-replay")).to_str().unwrap(),
-    ]));
-    let printed: serde_json::Value = serde_json::from_str(&replay).unwrap();
-    printed["fitness_percent_mean"].as_f64().unwrap()
+    common::replayed_fitness(&champion, &dir.join(format!("{name}-replay")), &[])
 }
 
 #[test]

@@ -16,6 +16,26 @@ pub fn binary() -> PathBuf {
     std::env::var_os("PSA_ESP_BIN").map_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_psa-esp")), PathBuf::from)
 }
 
+/// The fitness `psa-esp replay CHAMPION --backend native --json --out OUT
+/// EXTRA...` prints (`fitness_percent_mean`); panics with its stderr if it
+/// fails.
+pub fn replayed_fitness(champion: &Path, out: &Path, extra: &[&str]) -> f64 {
+    let mut args = vec![
+        "replay",
+        champion.to_str().unwrap(),
+        "--backend",
+        "native",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let o = psa_esp(&args);
+    assert!(o.status.success(), "replay: {}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    json["fitness_percent_mean"].as_f64().unwrap()
+}
+
 /// The arguments of a tiny grid (one seed of baseline on tasks 1-3, five
 /// generations) into `out`, after `command` (replicate).
 pub fn tiny_grid(command: &str, out: &Path) -> Vec<String> {
