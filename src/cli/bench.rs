@@ -193,13 +193,18 @@ struct EvaluationTiming {
 fn evaluations_per_second(path: &EvaluationPath, networks: &[Network], threads: usize, rounds: u64) -> Result<f64> {
     let evaluator = path.evaluator()?;
     let pool = psa_sim::ode::thread_pool(threads)?;
-    let mut rates = Vec::new();
-    for round in 0..rounds {
-        let start = Instant::now();
-        pool.install(|| evaluate_all(&evaluator, networks, round, &[]))?;
-        rates.push(networks.len() as f64 / start.elapsed().as_secs_f64());
-    }
+    let rates = (0..rounds)
+        .map(|round| pool.install(|| evaluation_rate(&evaluator, networks, round)))
+        .collect::<Result<Vec<f64>>>()?;
     Ok(median(rates))
+}
+
+/// Evaluations per second of one round of `networks` on `evaluator`, on
+/// the thread pool it is called in (the round seeds the trials).
+pub(super) fn evaluation_rate(evaluator: &PsaEvaluator, networks: &[Network], round: u64) -> Result<f64> {
+    let start = Instant::now();
+    evaluate_all(evaluator, networks, round, &[])?;
+    Ok(networks.len() as f64 / start.elapsed().as_secs_f64())
 }
 
 /// The logistic function alone, as the batched path computes it: blocks of

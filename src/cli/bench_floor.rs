@@ -5,19 +5,16 @@
 //! sensor read that once cost 3x) falls below a floor that the AVX2 and
 //! AVX-512 paths clear with room: CI runs it (`.ci/run`).
 
-use std::time::Instant;
-
 use anyhow::{bail, Result};
 use serde::Serialize;
 
+use super::bench::{evaluation_rate, EvaluationPath};
 use super::bench_networks::random_networks;
 use super::bench_runs::median;
 use super::EXIT_CHECK_FAILED;
-use esp_neuroevolution::evaluate_all;
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
 use psa_sim::numeric::SimdLevel;
 use psa_sim::physics::BackendKind;
-use psa_sim::psa::{PsaSettings, Task};
 
 /// What the check measured.
 #[derive(Debug, Serialize)]
@@ -48,20 +45,19 @@ pub fn check(floor: f64, level: Option<SimdLevel>, networks: u64, rounds: u64) -
     if !level.is_supported() {
         bail!("--speedup-level {}: this CPU does not support it", level.name());
     }
-    let settings = PsaSettings {
-        backend: BackendKind::Native,
-        ..PsaSettings::default()
+    let evaluator = |path| {
+        EvaluationPath {
+            backend: BackendKind::Native,
+            path,
+            input_noise: false,
+        }
+        .evaluator()
     };
-    let evaluator = |path: EvalPath| PsaEvaluator::new(settings.clone(), Task::StopRotation, &path);
     let scalar = evaluator(EvalPath::Scalar)?;
     let batched = evaluator(EvalPath::Simd(level))?;
     let networks = random_networks(networks)?;
     let pool = psa_sim::ode::thread_pool(1)?;
-    let rate = |evaluator: &PsaEvaluator, round: u64| -> Result<f64> {
-        let start = Instant::now();
-        pool.install(|| evaluate_all(evaluator, networks.as_slice(), round, &[]))?;
-        Ok(networks.len() as f64 / start.elapsed().as_secs_f64())
-    };
+    let rate = |evaluator: &PsaEvaluator, round: u64| pool.install(|| evaluation_rate(evaluator, &networks, round));
     let (mut scalar_rates, mut batched_rates, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
     for round in 0..rounds {
         let s = rate(&scalar, round)?;
