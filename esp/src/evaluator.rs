@@ -189,6 +189,11 @@ pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
                 Ok(fitness)
             },
         )
+        // Every result first, then the first error in network order: a
+        // parallel collect into `Result` would give whichever error a
+        // thread met first, which depends on the threads' timing.
+        .collect::<Vec<Result<f64, RunError>>>()
+        .into_iter()
         .collect()
 }
 
