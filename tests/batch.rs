@@ -11,6 +11,7 @@ use esp_neuroevolution::rng::stream;
 use kernel_cases::{
     assert_bit_identical, native, noisy_settings, original_fitness_settings, random_network, scalar_fitness, streams,
 };
+use psa_sim::evaluator::{trial_scores, EvalPath};
 use psa_sim::numeric::{Exponential, SimdLevel};
 use psa_sim::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
 use psa_sim::psa::cuda::{evaluate_with, fly_on_host};
@@ -196,6 +197,54 @@ fn blocks_of_every_width_and_ranges_of_a_set_give_the_same_fitness_as_a_full_blo
             assert_eq!(bits(&part), bits(&all[range.clone()]), "{range:?}, {level}");
         }
     }
+}
+
+#[test]
+fn a_networks_trials_flown_side_by_side_are_the_scalar_trials_bit_for_bit_on_every_path() {
+    // The robustness tests' many trials of one champion, one trial per
+    // lane: every width (a padded small block alone, small and narrow
+    // remainders, full wide blocks), with noise and random starts and
+    // without, on every SIMD level and through every evaluation path.
+    let clean = native(PsaSettings::default());
+    let cases = [
+        (clean.clone(), Task::Turn),
+        (noisy_settings(), Task::StopAtPosition),
+        (original_fitness_settings(), Task::StopRotation),
+    ];
+    let mut paths: Vec<EvalPath> = SimdLevel::ALL.into_iter().map(EvalPath::Simd).collect();
+    paths.extend([EvalPath::Fastest, EvalPath::Scalar, EvalPath::KernelOnHost]);
+    for (settings, task) in cases {
+        for trials in [1, SMALL_LANES + 1, NARROW_LANES + 3, 2 * LANES + 5] {
+            let settings = PsaSettings {
+                trials,
+                ..settings.clone()
+            };
+            for seed in 0..3 {
+                let network = random_network(9000 + seed);
+                let mut rng = stream(seed, &[4]);
+                let scalar = TrialRunner::new(&settings, task)
+                    .unwrap()
+                    .evaluate_trials(&network, &mut rng)
+                    .unwrap();
+                assert_eq!(scalar.len(), trials);
+                for path in &paths {
+                    let mut batched_rng = stream(seed, &[4]);
+                    let batched = trial_scores(&settings, task, &network, &mut batched_rng, path).unwrap();
+                    let what = format!("task {task}, {trials} trials, network {seed}, path {}", path.name());
+                    assert_bit_identical(&scalar, &batched, &what);
+                    assert_eq!(
+                        batched_rng.get_word_pos(),
+                        rng.get_word_pos(),
+                        "{what}: the stream moved apart"
+                    );
+                }
+            }
+        }
+    }
+    let runner = BatchRunner::new(&clean, Task::Turn).unwrap();
+    let wrong = Network::from_genes(3, 4, vec![0.0; 7]).unwrap();
+    let err = runner.evaluate_trials(&wrong, &mut stream(0, &[])).unwrap_err();
+    assert!(err.to_string().contains("needs 7"), "{err}");
 }
 
 #[test]

@@ -114,9 +114,8 @@ impl std::str::FromStr for EvalPath {
 
 /// Each trial's score (in % of the theoretical maximum) of `network` on
 /// `task` under `settings`, with `rng` (as [`TrialRunner::evaluate_trials`]
-/// gives them, bit for bit): on `path`'s kernel (a GPU, or the host build)
-/// in one launch where it has one, else on the scalar path. The robustness
-/// tests' many trials of a champion.
+/// gives them, bit for bit), on `path` ([`PsaEvaluator::trial_scores`]):
+/// the robustness tests' many trials of a champion.
 pub fn trial_scores(
     settings: &PsaSettings,
     task: Task,
@@ -124,14 +123,7 @@ pub fn trial_scores(
     rng: &mut Stream,
     path: &EvalPath,
 ) -> Result<Vec<f64>> {
-    let flier: Arc<dyn TrialFlier> = match path {
-        EvalPath::Kernel(flier) => flier.clone(),
-        EvalPath::KernelOnHost => Arc::new(HostTrials),
-        _ => return Ok(TrialRunner::new(settings, task)?.evaluate_trials(network, rng)?),
-    };
-    Ok(cuda::trial_scores_with(settings, task, network, rng, |batch| {
-        flier.fly(batch)
-    })?)
+    PsaEvaluator::new(settings.clone(), task, path)?.trial_scores(network, rng)
 }
 
 /// Scores a network by its fitness on a task (in % of the theoretical
@@ -308,6 +300,27 @@ impl Evaluator for PsaEvaluator {
 }
 
 impl PsaEvaluator {
+    /// Each trial's score (in % of the theoretical maximum) of `network`
+    /// with `rng`, as [`TrialRunner::evaluate_trials`] gives them, bit for
+    /// bit: on the batched path side by side, one trial per lane
+    /// ([`BatchRunner::evaluate_trials`]); on a kernel in one launch; else
+    /// one trial after another.
+    pub fn trial_scores(&self, network: &Network, rng: &mut Stream) -> Result<Vec<f64>> {
+        match &self.route {
+            Route::Batched(batch) => Ok(batch.evaluate_trials(network, rng)?),
+            Route::Kernel(flier) => Ok(cuda::trial_scores_with(
+                &self.settings,
+                self.task,
+                network,
+                rng,
+                |batch| flier.fly(batch),
+            )?),
+            Route::Scalar | Route::OdeLockstep => {
+                Ok(TrialRunner::new(&self.settings, self.task)?.evaluate_trials(network, rng)?)
+            }
+        }
+    }
+
     /// The fitness of networks `range` of `networks`, network
     /// `range.start + i` with the stream `rngs[i]` (any streams, such as
     /// one per network from a seed of its own), on this evaluator's path:

@@ -80,9 +80,10 @@ pub fn tested_settings(problem: &PsaSettings, task: Task) -> Result<PsaSettings>
 /// run's control problem, scored with its scoring fitness
 /// ([`PsaSettings::scoring_for`]); its noise, random initialisation and
 /// trials are replaced by each test's own (the input noise keeps whether it
-/// reaches the bias). Each test's trials fly on `path`'s kernel (the GPU
-/// with `--backend cuda`) in one launch where it has one, else on the
-/// scalar path: the same scores either way.
+/// reaches the bias). Each test's trials fly on `path`
+/// ([`trial_scores`]): on `native`'s batched path side by side, one trial
+/// per lane; on a kernel (the GPU with `--backend cuda`) in one launch;
+/// else one after another. The same scores on every path.
 pub fn test_robustness(
     champion: &Network,
     task: Task,

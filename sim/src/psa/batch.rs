@@ -36,7 +36,7 @@ use crate::numeric::{
     clamp_unit, sigmoid_with, Exponential, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words,
 };
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
-use esp_neuroevolution::network::NetworkSet;
+use esp_neuroevolution::network::{Network, NetworkSet};
 use esp_neuroevolution::rng::Stream;
 
 /// Networks evaluated in lockstep by one call of the kernel: four AVX-512
@@ -66,12 +66,13 @@ struct BlockWeights<const N: usize> {
 }
 
 impl<const N: usize> BlockWeights<N> {
-    /// The weights of networks `block` of `networks`, lane by lane.
-    fn new<S: NetworkSet + ?Sized>(networks: &S, block: Range<usize>) -> BlockWeights<N> {
-        let hidden = block.clone().map(|j| networks.hidden(j)).max().unwrap_or(0);
+    /// The weights of network `lanes[l]` of `networks` in lane `l` (a
+    /// block of networks, or one network in every lane).
+    fn new<S: NetworkSet + ?Sized>(networks: &S, lanes: impl Iterator<Item = usize> + Clone) -> BlockWeights<N> {
+        let hidden = lanes.clone().map(|j| networks.hidden(j)).max().unwrap_or(0);
         let mut input = vec![Lanes::splat(0.0); hidden * INPUT_COUNT];
         let mut output = vec![Lanes::splat(0.0); hidden * THRUSTER_COUNT];
-        for (lane, j) in block.enumerate() {
+        for (lane, j) in lanes.enumerate() {
             for k in (0..networks.hidden(j)).filter(|&k| !networks.is_lesioned(j, k)) {
                 let (w_in, w_out) = networks.neuron(j, k).split_at(INPUT_COUNT);
                 for (i, &w) in w_in.iter().enumerate() {
@@ -130,9 +131,29 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     let e = s.exponential;
     let zero = V::<N>::splat(0.0);
     let mut points = zero;
-    let read = read_sensors::<N, NOISY>;
-    let mut reading = read(s, state, target, noise);
-    for _ in 0..s.steps {
+    // One call of the sensors (and of their noise) in the loop, not two:
+    // each call is a copy of the inlined sensor and noise code, and the
+    // copies were much of the noisy kernels' compile time. Step `step`
+    // reads the state it starts from and scores the step before it.
+    let mut before: Option<Reading<V<N>>> = None;
+    let mut previous_omega = zero;
+    for step in 0..=s.steps {
+        let reading = read_sensors::<N, NOISY>(s, state, target, noise);
+        if let Some(before) = &before {
+            points = points
+                + score(
+                    s.step(),
+                    &reading,
+                    before,
+                    state.position,
+                    state.omega,
+                    previous_omega,
+                    *target,
+                );
+        }
+        if step == s.steps {
+            break;
+        }
         let inputs = reading.inputs;
         let mut outputs = [zero; THRUSTER_COUNT];
         let (paired, grouped) = (G == 2, G >= THRUSTER_COUNT);
@@ -181,20 +202,9 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
                 *o = clamp_unit(*o);
             }
         }
-        let previous_omega = state.omega;
+        previous_omega = state.omega;
         flight.body.step(state, &outputs);
-        let next = read(s, state, target, noise);
-        points = points
-            + score(
-                s.step(),
-                &next,
-                &reading,
-                state.position,
-                state.omega,
-                previous_omega,
-                *target,
-            );
-        reading = next;
+        before = Some(reading);
     }
     let finite = |v: V<N>| v.abs().le(V::<N>::splat(f64::MAX));
     (
@@ -294,19 +304,17 @@ fn read_sensors<const N: usize, const NOISY: bool>(
     )
 }
 
-/// The kernel of width `$n`, with or without noise, evaluating the neurons'
-/// logistic functions `$group` neurons at a time (see [`fly`]): compiled for
-/// the `multiversion` target `$target` when given, else for the build's
-/// baseline (the portable kernel).
+/// `$name`: the kernel of width `$n`, with or without noise, evaluating the
+/// neurons' logistic functions `$group` neurons at a time (see [`fly`]),
+/// compiled for the `multiversion` target `$target` when given, else for
+/// the build's baseline (the portable kernel).
 ///
 /// `multiversion` compiles a target's function twice: for the target, and
-/// as a fallback for processors without its features. `run` never calls a
-/// target's kernel on such a processor (it runs the [`SimdLevel`] asked
-/// for, which the processor has), so the fallback is a call of the
-/// portable kernel (`match_target!` compiles only the arm of the clone's
-/// target): not a second and third copy of the whole flight for baseline
-/// x86-64, which were 12 of the 30 kernels the build compiled and about
-/// half of their machine code.
+/// as a fallback for processors without its features. A target's kernel
+/// is only ever called on a processor that has the target
+/// ([`BatchRunner::each_block`] runs the portable kernels where the level
+/// asked for is missing), so the fallback is `unreachable!`: not another
+/// copy of the whole flight for baseline x86-64.
 macro_rules! kernel {
     ($name:ident, $target:tt, $n:expr, $group:expr, $noisy:expr) => {
         #[multiversion(targets($target))]
@@ -318,7 +326,10 @@ macro_rules! kernel {
         ) -> (Lanes<$n>, LaneMask<$n>) {
             multiversion::target::match_target! {
                 $target => fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise),
-                _ => portable(flight, state, target, noise),
+                _ => {
+                    let _ = (flight, state, target, noise);
+                    unreachable!("a {} kernel called on a processor without it", $target)
+                }
             }
         }
     };
@@ -334,51 +345,58 @@ macro_rules! kernel {
     };
 }
 
-/// A module `$module` holding the kernel of width `$n` (noisy or not)
-/// compiled for each [`SimdLevel`], with the logistic functions `$g512`
-/// neurons at a time on AVX-512 and `$g256` on AVX2 (one at a time on the
-/// portable build), and `run`, which runs the one asked for.
+/// The kernels of width `$n` (noisy or not), as a module `$module`: for
+/// AVX-512 (the logistic functions `$g512` neurons at a time), AVX2
+/// (`$g256`) and the portable build (one at a time), each only where a
+/// level uses the width ([`BatchRunner::each_block`]). Every kernel is a
+/// large function of its own, and the kernels are most of the crate's
+/// compile time (docs/performance.md, "Building").
 macro_rules! kernels {
-    ($module:ident, $n:expr, $noisy:expr, $g512:expr, $g256:expr, $avx512:tt, $avx2:tt) => {
+    ($module:ident, $n:expr, $noisy:expr, [$(avx512 $g512:expr)?], [$(avx2 $g256:expr)?], [$(portable $portable:ident)?], $avx512:tt, $avx2:tt) => {
         mod $module {
             use super::*;
 
-            kernel!(avx512, $avx512, $n, $g512, $noisy);
-            kernel!(avx2, $avx2, $n, $g256, $noisy);
-            kernel!(portable, $n, 1, $noisy);
-
-            pub(super) fn run(
-                level: SimdLevel,
-                flight: &Flight<$n>,
-                state: &mut PlanarState<Lanes<$n>>,
-                target: &[Lanes<$n>; 3],
-                noise: &mut NoiseSource<Words<$n>>,
-            ) -> (Lanes<$n>, LaneMask<$n>) {
-                match level {
-                    SimdLevel::Avx512 => avx512(flight, state, target, noise),
-                    SimdLevel::Avx2 => avx2(flight, state, target, noise),
-                    SimdLevel::Portable => portable(flight, state, target, noise),
-                }
-            }
+            // A module each, so that each kernel gets a codegen unit of
+            // its own: the two of a width in one unit were compiled one
+            // after the other, on the build's critical path.
+            $(pub(super) mod avx512 {
+                use super::*;
+                kernel!(run, $avx512, $n, $g512, $noisy);
+                pub(in super::super) const RUN: Kernel<{ $n }> = run;
+            })?
+            $(pub(super) mod avx2 {
+                use super::*;
+                kernel!(run, $avx2, $n, $g256, $noisy);
+                pub(in super::super) const RUN: Kernel<{ $n }> = run;
+            })?
+            $(pub(super) mod $portable {
+                use super::*;
+                kernel!(run, $n, 1, $noisy);
+                pub(in super::super) const RUN: Kernel<{ $n }> = run;
+            })?
         }
     };
 }
 
-crate::with_simd_targets!(kernels!(wide, LANES, false, 2, 1,));
-crate::with_simd_targets!(kernels!(wide_noisy, LANES, true, 2, 1,));
-crate::with_simd_targets!(kernels!(narrow, NARROW_LANES, false, 5, 1,));
-crate::with_simd_targets!(kernels!(narrow_noisy, NARROW_LANES, true, 5, 1,));
-crate::with_simd_targets!(kernels!(small, SMALL_LANES, false, 5, 1,));
-crate::with_simd_targets!(kernels!(small_noisy, SMALL_LANES, true, 5, 1,));
+crate::with_simd_targets!(kernels!(wide, LANES, false, [avx512 2], [avx2 1], [],));
+crate::with_simd_targets!(kernels!(wide_noisy, LANES, true, [avx512 2], [avx2 1], [],));
+crate::with_simd_targets!(kernels!(narrow, NARROW_LANES, false, [avx512 5], [], [],));
+crate::with_simd_targets!(kernels!(narrow_noisy, NARROW_LANES, true, [avx512 5], [], [],));
+crate::with_simd_targets!(kernels!(small, SMALL_LANES, false, [], [avx2 1], [portable portable],));
+crate::with_simd_targets!(kernels!(small_noisy, SMALL_LANES, true, [], [avx2 1], [portable portable],));
 
-/// A kernel of width N run on a [`SimdLevel`].
-type Kernel<const N: usize> = fn(
-    SimdLevel,
-    &Flight<N>,
-    &mut PlanarState<Lanes<N>>,
-    &[Lanes<N>; 3],
-    &mut NoiseSource<Words<N>>,
-) -> (Lanes<N>, LaneMask<N>);
+/// A kernel of width N.
+type Kernel<const N: usize> =
+    fn(&Flight<N>, &mut PlanarState<Lanes<N>>, &[Lanes<N>; 3], &mut NoiseSource<Words<N>>) -> (Lanes<N>, LaneMask<N>);
+
+/// The kernel `clean`, or `noisy` where the settings have noise.
+fn pick<const N: usize>(noisy: bool, clean: Kernel<N>, with_noise: Kernel<N>) -> Kernel<N> {
+    if noisy {
+        with_noise
+    } else {
+        clean
+    }
+}
 
 /// Evaluates networks on one task in blocks of [`LANES`], on the `native`
 /// backend's physics, with the best [`SimdLevel`] of the CPU.
@@ -422,20 +440,19 @@ impl BatchRunner {
     }
 
     /// The fewest networks worth a block of their own on this runner's
-    /// SIMD level. On AVX-512 a block of [`SMALL_LANES`] networks, one
-    /// register per value, is bound by the latency of a step's long
-    /// dependency chain and takes longer than one of [`NARROW_LANES`];
-    /// on AVX2 (two registers per value) and the portable build it takes
-    /// less. Measured on Zen 5 (`psa-esp bench --steps 500 --rounds 7
-    /// --networks 8`, and `16`, two runs each): AVX-512 27.9-33.0 against
-    /// 11.5-11.6 ns per network-step, so 8 networks take 1.2-1.4 times as
-    /// long as 16; AVX2 32.6-34.5 against 22.1-22.8 ns, about three
-    /// quarters as long.
+    /// SIMD level: its narrow width ([`BatchRunner::each_block`]). On
+    /// AVX-512 a block of [`SMALL_LANES`] networks, one register per value,
+    /// is bound by the latency of a step's long dependency chain and takes
+    /// longer than one of [`NARROW_LANES`]; on AVX2 (two registers per
+    /// value) and the portable build it takes less. Measured on Zen 5
+    /// (`psa-esp bench --steps 500 --rounds 7 --networks 8`, and `16`, two
+    /// runs each): AVX-512 27.9-33.0 against 11.5-11.6 ns per network-step,
+    /// so 8 networks take 1.2-1.4 times as long as 16; AVX2 32.6-34.5
+    /// against 22.1-22.8 ns, about three quarters as long.
     pub fn narrowest_block(&self) -> usize {
-        if self.level == SimdLevel::Avx512 && self.level.is_supported() {
-            NARROW_LANES
-        } else {
-            SMALL_LANES
+        match self.running_level() {
+            SimdLevel::Avx512 => NARROW_LANES,
+            SimdLevel::Avx2 | SimdLevel::Portable => SMALL_LANES,
         }
     }
 
@@ -454,106 +471,243 @@ impl BatchRunner {
         rngs: &mut [Stream],
     ) -> Result<Vec<f64>, PsaError> {
         assert_eq!(range.len(), rngs.len(), "one stream per network");
-        let mut fitness = Vec::with_capacity(range.len());
-        let noisy = self.settings.noise.is_active();
-        let mut start = range.start;
-        while start < range.end {
-            let left = range.end - start;
-            // Full wide blocks; a remainder goes in the narrowest block it fits.
-            let width = if left > NARROW_LANES {
-                LANES
-            } else if left > SMALL_LANES {
-                NARROW_LANES
-            } else {
-                SMALL_LANES
-            };
-            let block = start..start + left.min(width);
-            let streams = &mut rngs[block.start - range.start..block.end - range.start];
-            let out = &mut fitness;
-            match width {
-                LANES => {
-                    let fly = if noisy { wide_noisy::run } else { wide::run };
-                    self.evaluate_block::<LANES, S>(fly, networks, block.clone(), streams, out)?;
-                }
-                NARROW_LANES => {
-                    let fly = if noisy { narrow_noisy::run } else { narrow::run };
-                    self.evaluate_block::<NARROW_LANES, S>(fly, networks, block.clone(), streams, out)?;
-                }
-                _ => {
-                    let fly = if noisy { small_noisy::run } else { small::run };
-                    self.evaluate_block::<SMALL_LANES, S>(fly, networks, block.clone(), streams, out)?;
-                }
-            }
-            start = block.end;
-        }
-        Ok(fitness)
+        let mut job = NetworkBlocks {
+            runner: self,
+            networks,
+            first: range.start,
+            rngs,
+            fitness: Vec::with_capacity(range.len()),
+        };
+        self.each_block(range.len(), &mut job)?;
+        Ok(job.fitness)
     }
 
-    /// Evaluates networks `block` (at most N) with the kernel `fly`,
-    /// appending their fitness.
-    fn evaluate_block<const N: usize, S: NetworkSet + ?Sized>(
+    /// Each trial's score of `network`, in % of the theoretical maximum:
+    /// exactly what [`TrialRunner::evaluate_trials`] gives with `rng`, the
+    /// trials flown side by side, one per lane (the robustness tests' many
+    /// trials of one champion). A trial's start and noise seed do not
+    /// depend on any flight, so they are drawn first, in the scalar path's
+    /// order. Where a start is invalid or a flight ends non-finite, the
+    /// scalar path runs the trials again from `rng`'s first position and
+    /// names the error in the order it meets it.
+    pub fn evaluate_trials(&self, network: &Network, rng: &mut Stream) -> Result<Vec<f64>, PsaError> {
+        let (inputs, outputs) = NetworkSet::shape(std::slice::from_ref(network), 0);
+        TrialRunner::check_shape(inputs, outputs)?;
+        let position = rng.get_word_pos();
+        let scalar = |rng: &mut Stream| {
+            rng.set_word_pos(position);
+            TrialRunner::new(&self.settings, self.task)?.evaluate_trials(network, rng)
+        };
+        let drawn: Result<Vec<Drawn>, PsaError> = (0..self.settings.trials).map(|_| self.draw(rng)).collect();
+        let Ok(drawn) = drawn else {
+            return scalar(rng);
+        };
+        let mut job = TrialBlocks {
+            runner: self,
+            network,
+            drawn: &drawn,
+            scores: Vec::with_capacity(drawn.len()),
+            finite: true,
+        };
+        self.each_block(drawn.len(), &mut job)?;
+        if job.finite {
+            Ok(job.scores)
+        } else {
+            scalar(rng)
+        }
+    }
+
+    /// The level the kernels run on: the one asked for where the CPU has
+    /// it, else the portable build.
+    fn running_level(&self) -> SimdLevel {
+        if self.level.is_supported() {
+            self.level
+        } else {
+            SimdLevel::Portable
+        }
+    }
+
+    /// Runs `job` on `count` items cut into blocks, each with the kernel of
+    /// its width (noisy where the settings have noise), by the running
+    /// level's two widths: full blocks of the wide one, and a remainder of
+    /// more than half of it in one padded wide block, else in blocks of the
+    /// narrow one (see [`BatchRunner::narrowest_block`]). AVX-512 flies
+    /// [`LANES`] and [`NARROW_LANES`], AVX2 [`LANES`] and [`SMALL_LANES`],
+    /// the portable build [`SMALL_LANES`] only. Lanes fly independently,
+    /// so the cut changes speed, never a result.
+    fn each_block(&self, count: usize, job: &mut impl BlockJob) -> Result<(), PsaError> {
+        let noisy = self.settings.noise.is_active();
+        match self.running_level() {
+            SimdLevel::Avx512 => cut(
+                count,
+                job,
+                pick(noisy, wide::avx512::RUN, wide_noisy::avx512::RUN),
+                pick(noisy, narrow::avx512::RUN, narrow_noisy::avx512::RUN),
+            ),
+            SimdLevel::Avx2 => cut(
+                count,
+                job,
+                pick(noisy, wide::avx2::RUN, wide_noisy::avx2::RUN),
+                pick(noisy, small::avx2::RUN, small_noisy::avx2::RUN),
+            ),
+            SimdLevel::Portable => {
+                let small = pick(noisy, small::portable::RUN, small_noisy::portable::RUN);
+                cut(count, job, small, small)
+            }
+        }
+    }
+
+    /// One trial's start, target and noise seed, drawn from `rng` in the
+    /// scalar path's order.
+    fn draw(&self, rng: &mut Stream) -> Result<Drawn, PsaError> {
+        let s = &self.settings;
+        let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
+        start.validate()?;
+        Ok(Drawn {
+            start: self.body.start_state(&start),
+            target: [target.x, target.y, target.heading],
+            seed: s.noise.draw_seed(rng),
+        })
+    }
+
+    /// One trial of every lane with `fly`, lane `l` of `weights` from
+    /// `drawn[l]` (lanes past `drawn`, at most N, repeat its first trial):
+    /// each lane's points and which lanes ended finite.
+    fn fly_lanes<const N: usize>(
         &self,
         fly: Kernel<N>,
-        networks: &S,
-        block: Range<usize>,
-        rngs: &mut [Stream],
-        fitness: &mut Vec<f64>,
-    ) -> Result<(), PsaError> {
-        for j in block.clone() {
-            let (inputs, outputs) = networks.shape(j);
+        weights: &BlockWeights<N>,
+        drawn: &[Drawn],
+    ) -> (Lanes<N>, LaneMask<N>) {
+        let lane = |l: usize| &drawn[if l < drawn.len() { l } else { 0 }];
+        let lanes = |f: &dyn Fn(&Drawn) -> f64| Lanes(std::array::from_fn(|l| f(lane(l))));
+        let mut state = PlanarState {
+            position: [lanes(&|d| d.start.position[0]), lanes(&|d| d.start.position[1])],
+            velocity: [lanes(&|d| d.start.velocity[0]), lanes(&|d| d.start.velocity[1])],
+            quaternion: [lanes(&|d| d.start.quaternion[0]), lanes(&|d| d.start.quaternion[1])],
+            omega: lanes(&|d| d.start.omega),
+        };
+        let target = [0, 1, 2].map(|i| lanes(&|d| d.target[i]));
+        let mut noise = NoiseSource::from_seeds(&std::array::from_fn(|l| lane(l).seed));
+        let flight = Flight {
+            settings: &self.settings,
+            body: &self.body,
+            weights,
+        };
+        fly(&flight, &mut state, &target, &mut noise)
+    }
+}
+
+/// Runs `job` on `count` items: full blocks of `W` with `wide`, then
+/// what is left in one padded block of `W` if it is more than half of
+/// `W`, else in blocks of `R` with `narrow`.
+fn cut<const W: usize, const R: usize>(
+    count: usize,
+    job: &mut impl BlockJob,
+    wide: Kernel<W>,
+    narrow: Kernel<R>,
+) -> Result<(), PsaError> {
+    let full = count - count % W;
+    for start in (0..full).step_by(W) {
+        job.run::<W>(wide, start..start + W)?;
+    }
+    if count - full > W / 2 {
+        return job.run::<W>(wide, full..count);
+    }
+    for start in (full..count).step_by(R) {
+        job.run::<R>(narrow, start..count.min(start + R))?;
+    }
+    Ok(())
+}
+
+/// One trial's start, target (x, y, heading) and noise seed.
+struct Drawn {
+    start: PlanarState<f64>,
+    target: [f64; 3],
+    seed: u64,
+}
+
+/// Work done block by block by [`BatchRunner::each_block`].
+trait BlockJob {
+    /// Items `block` (at most N) with the kernel `fly` of width N.
+    fn run<const N: usize>(&mut self, fly: Kernel<N>, block: Range<usize>) -> Result<(), PsaError>;
+}
+
+/// Networks flown a block at a time, one per lane, every trial of the
+/// block in turn ([`BatchRunner::evaluate`]).
+struct NetworkBlocks<'a, S: NetworkSet + ?Sized> {
+    runner: &'a BatchRunner,
+    networks: &'a S,
+    /// The network of the first stream.
+    first: usize,
+    /// One stream per network.
+    rngs: &'a mut [Stream],
+    fitness: Vec<f64>,
+}
+
+impl<S: NetworkSet + ?Sized> BlockJob for NetworkBlocks<'_, S> {
+    fn run<const N: usize>(&mut self, fly: Kernel<N>, block: Range<usize>) -> Result<(), PsaError> {
+        let networks = block.start + self.first..block.end + self.first;
+        for j in networks.clone() {
+            let (inputs, outputs) = self.networks.shape(j);
             TrialRunner::check_shape(inputs, outputs)?;
         }
-        let s = &self.settings;
+        let (runner, s) = (self.runner, &self.runner.settings);
+        let rngs = &mut self.rngs[block];
         // Where each stream stood, for a lane that must be re-run.
         let positions: Vec<u128> = rngs.iter().map(|r| r.get_word_pos()).collect();
-        let weights = BlockWeights::<N>::new(networks, block.clone());
-        let flight = Flight {
-            settings: s,
-            body: &self.body,
-            weights: &weights,
-        };
+        let weights = BlockWeights::<N>::new(self.networks, networks.clone());
         let maximum = s.fitness.maximum(s.steps);
         // trials[lane * s.trials + t]: lane's fitness in trial t.
-        let mut trials = vec![0.0; block.len() * s.trials];
+        let mut trials = vec![0.0; networks.len() * s.trials];
         let mut valid = Lanes::<N>::splat(0.0).le(Lanes::splat(0.0));
         for t in 0..s.trials {
-            let mut starts = [PlanarState::from_body_state(&Default::default()); N];
-            let mut targets = [[0.0; 3]; N];
-            let mut seeds = [0; N];
-            for (lane, rng) in rngs.iter_mut().enumerate() {
-                let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
-                start.validate()?;
-                starts[lane] = self.body.start_state(&start);
-                targets[lane] = [target.x, target.y, target.heading];
-                seeds[lane] = s.noise.draw_seed(rng);
-            }
-            for lane in block.len()..N {
-                (starts[lane], targets[lane]) = (starts[0], targets[0]);
-            }
-            let mut noise = NoiseSource::from_seeds(&seeds);
-            let lanes = |f: &dyn Fn(usize) -> f64| Lanes(std::array::from_fn(f));
-            let mut state = PlanarState {
-                position: [lanes(&|l| starts[l].position[0]), lanes(&|l| starts[l].position[1])],
-                velocity: [lanes(&|l| starts[l].velocity[0]), lanes(&|l| starts[l].velocity[1])],
-                quaternion: [lanes(&|l| starts[l].quaternion[0]), lanes(&|l| starts[l].quaternion[1])],
-                omega: lanes(&|l| starts[l].omega),
-            };
-            let target = [0, 1, 2].map(|i| lanes(&|l| targets[l][i]));
-            let (points, ok) = fly(self.level, &flight, &mut state, &target, &mut noise);
+            let drawn = rngs
+                .iter_mut()
+                .map(|rng| runner.draw(rng))
+                .collect::<Result<Vec<_>, _>>()?;
+            let (points, ok) = runner.fly_lanes(fly, &weights, &drawn);
             valid = valid & ok;
-            for lane in 0..block.len() {
+            for lane in 0..networks.len() {
                 trials[lane * s.trials + t] = 100.0 * points[lane] / maximum;
             }
         }
         for (lane, trial) in trials.chunks_exact(s.trials).enumerate() {
             if valid.0[lane] != 0 {
-                fitness.push(mean_of_trials(trial));
+                self.fitness.push(mean_of_trials(trial));
             } else {
                 // The scalar path, from the lane's original stream, names the problem.
                 rngs[lane].set_word_pos(positions[lane]);
-                let network = networks.network(block.start + lane);
-                fitness.push(TrialRunner::new(s, self.task)?.evaluate(&network, &mut rngs[lane])?);
+                let network = self.networks.network(networks.start + lane);
+                self.fitness
+                    .push(TrialRunner::new(s, runner.task)?.evaluate(&network, &mut rngs[lane])?);
             }
+        }
+        Ok(())
+    }
+}
+
+/// One network's trials flown a block at a time, one trial per lane
+/// ([`BatchRunner::evaluate_trials`]).
+struct TrialBlocks<'a> {
+    runner: &'a BatchRunner,
+    network: &'a Network,
+    drawn: &'a [Drawn],
+    scores: Vec<f64>,
+    /// Whether every flight so far ended finite.
+    finite: bool,
+}
+
+impl BlockJob for TrialBlocks<'_> {
+    fn run<const N: usize>(&mut self, fly: Kernel<N>, block: Range<usize>) -> Result<(), PsaError> {
+        let s = &self.runner.settings;
+        let networks = std::slice::from_ref(self.network);
+        let weights = BlockWeights::<N>::new(networks, std::iter::repeat_n(0, block.len()));
+        let (points, ok) = self.runner.fly_lanes(fly, &weights, &self.drawn[block.clone()]);
+        let maximum = s.fitness.maximum(s.steps);
+        for lane in 0..block.len() {
+            self.finite &= ok.0[lane] != 0;
+            self.scores.push(100.0 * points[lane] / maximum);
         }
         Ok(())
     }
