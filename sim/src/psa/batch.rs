@@ -440,7 +440,9 @@ impl BatchRunner {
     }
 
     /// The fewest networks worth a block of their own on this runner's
-    /// SIMD level: its narrow width ([`BatchRunner::each_block`]). On
+    /// SIMD level: its narrow width, the block a remainder flies in
+    /// (AVX-512 [`NARROW_LANES`], AVX2 and the portable build
+    /// [`SMALL_LANES`]; full blocks are [`LANES`] wide). On
     /// AVX-512 a block of [`SMALL_LANES`] networks, one register per value,
     /// is bound by the latency of a step's long dependency chain and takes
     /// longer than one of [`NARROW_LANES`]; on AVX2 (two registers per
