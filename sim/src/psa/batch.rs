@@ -43,15 +43,16 @@ use esp_neuroevolution::rng::Stream;
 /// registers per value, enough independent work to hide the latency of the
 /// long dependency chain of one step.
 pub const LANES: usize = 32;
-/// The kernel's width for the last few networks of a batch (at most this
+/// AVX-512's width for the last few networks of a batch (at most this
 /// many): two AVX-512 registers per value. On the baseline ESP's 400
 /// networks a generation (12 wide blocks and 16 left), measured 6 % faster
 /// overall than 8 lanes.
 pub const NARROW_LANES: usize = 16;
-/// The kernel's width for a remainder of at most this many networks: one
-/// AVX-512 register per value. On two threads that both reach the tail,
-/// the 16 networks left of the baseline ESP's 400 go one piece of 8 to
-/// each thread; in a narrow block, half of its lanes would fly for nothing.
+/// AVX2's width for the last few networks of a batch (two AVX2 registers
+/// per value), and the portable build's only width. On two threads that
+/// both reach the tail, the 16 networks left of the baseline ESP's 400 go
+/// one piece of 8 to each thread; in a block of 16, half of its lanes
+/// would fly for nothing.
 pub const SMALL_LANES: usize = 8;
 
 /// The weights of a block of networks, lane by lane. Lesioned hidden
@@ -493,8 +494,7 @@ impl BatchRunner {
     /// scalar path runs the trials again from `rng`'s first position and
     /// names the error in the order it meets it.
     pub fn evaluate_trials(&self, network: &Network, rng: &mut Stream) -> Result<Vec<f64>, PsaError> {
-        let (inputs, outputs) = NetworkSet::shape(std::slice::from_ref(network), 0);
-        TrialRunner::check_shape(inputs, outputs)?;
+        TrialRunner::check_network(network)?;
         let position = rng.get_word_pos();
         let scalar = |rng: &mut Stream| {
             rng.set_word_pos(position);
