@@ -212,7 +212,7 @@ fn replay_flies_a_champion_on_the_model_it_was_evolved_under() {
     let run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
     let evolved = run["champion_fitness"].as_f64().unwrap();
     let champion = out.join("champion.json");
-    let replay = |extra: &[&str]| common::replayed_fitness(&champion, &dir.path().join("replay"), extra);
+    let replay = |extra: &[&str]| common::replayed_fitness(&champion, "native", &dir.path().join("replay"), extra);
     assert_eq!(replay(&[]), evolved, "the recorded model gives the evolved fitness");
     let on_default = replay(&["--default-model"]);
     assert_ne!(on_default, evolved, "the default model is another model");

@@ -356,7 +356,7 @@ fn champion_of(dir: &Path, name: &str, config: &str, task: &str) -> (f64, serde_
 fn replayed(dir: &Path, name: &str, json: &serde_json::Value) -> f64 {
     let champion = dir.join(format!("{name}.json"));
     std::fs::write(&champion, json.to_string()).unwrap();
-    common::replayed_fitness(&champion, &dir.join(format!("{name}-replay")), &[])
+    common::replayed_fitness(&champion, "native", &dir.join(format!("{name}-replay")), &[])
 }
 
 #[test]

@@ -138,24 +138,9 @@ fn the_paper_preset_checks_on_ode_by_default_and_the_check_needs_native() {
 /// of seed 62 on `backend`, with `extra` arguments.
 fn random_start_fitness(network: &Path, backend: &str, extra: &[&str]) -> f64 {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("replay");
-    let mut args = vec![
-        "replay",
-        network.to_str().unwrap(),
-        "--random-init",
-        "--seed",
-        "62",
-        "--backend",
-        backend,
-        "--json",
-        "--out",
-        out.to_str().unwrap(),
-    ];
+    let mut args = vec!["--random-init", "--seed", "62"];
     args.extend(extra);
-    let o = psa_esp(&args);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    report["fitness_percent_mean"].as_f64().unwrap()
+    common::replayed_fitness(network, backend, &dir.path().join("replay"), &args)
 }
 
 #[test]

@@ -16,15 +16,15 @@ pub fn binary() -> PathBuf {
     std::env::var_os("PSA_ESP_BIN").map_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_psa-esp")), PathBuf::from)
 }
 
-/// The fitness `psa-esp replay CHAMPION --backend native --json --out OUT
+/// The fitness `psa-esp replay CHAMPION --backend BACKEND --json --out OUT
 /// EXTRA...` prints (`fitness_percent_mean`); panics with its stderr if it
 /// fails.
-pub fn replayed_fitness(champion: &Path, out: &Path, extra: &[&str]) -> f64 {
+pub fn replayed_fitness(champion: &Path, backend: &str, out: &Path, extra: &[&str]) -> f64 {
     let mut args = vec![
         "replay",
         champion.to_str().unwrap(),
         "--backend",
-        "native",
+        backend,
         "--json",
         "--out",
         out.to_str().unwrap(),
