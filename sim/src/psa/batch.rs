@@ -104,8 +104,8 @@ struct Flight<'a, const N: usize> {
 /// of `G` and the four outputs in one group ([`sigmoid_group`]), `G = 1`
 /// one by one. Measured on Zen 5: pairs are faster in the wide AVX-512
 /// kernel and slower on AVX2, which has half as many registers; groups of
-/// five made the narrow AVX-512 kernel 16-20 % faster and the small one
-/// 22-35 % (`psa-esp bench --networks 16` and `8`, two runs each).
+/// five made the narrow AVX-512 kernel 16-20 % faster (`psa-esp bench
+/// --networks 16`, two runs).
 ///
 /// A lane whose thrust turned NaN is always among those that did not: a NaN
 /// command makes its thruster's world-frame force NaN (`PlanarBody` keeps
