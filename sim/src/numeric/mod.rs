@@ -30,7 +30,7 @@ use esp_neuroevolution::math::TWO_52;
 pub use esp_neuroevolution::math::{Exponential, Float};
 pub use lanes::{LaneMask, Lanes, Words};
 pub use math::{atan2, clamp_unit, exp, fmod, ln, sigmoid, sigmoid_with, sin_cos_quarter_turns, wrap_angle};
-pub use normal::{NoiseSource, Word};
+pub use normal::{NoiseSource, Normals, OutOfLine, Word};
 
 /// A real number, or a bundle of them computed lane by lane: the search
 /// crate's [`Float`] (what the network's activation needs) and the rest of

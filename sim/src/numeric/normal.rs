@@ -1,7 +1,7 @@
 //! Gaussian noise that the scalar and the batched paths draw identically:
 //! every lane runs its own generator, and the arithmetic is shared.
 
-use super::{ln, sin_cos_quarter_turns, Real, Words};
+use super::{ln, sin_cos_quarter_turns, Lanes, Real, Words};
 use esp_neuroevolution::rng::expand;
 
 /// Unsigned 64-bit words, or a bundle of them (one per lane): the state and
@@ -98,19 +98,54 @@ impl<W: Word> NoiseSource<W> {
         let (x, y) = (R::select(quarter, -sin, cos), R::select(quarter, cos, sin));
         (radius * x, radius * y)
     }
+}
+
+/// Pairs of standard normal numbers, in a stream's order, and the noise
+/// added from them: a [`NoiseSource`] drawing inline, or one whose pairs
+/// come from a function of their own ([`OutOfLine`]).
+pub trait Normals<R: Real> {
+    /// The stream's next two independent standard normal numbers.
+    fn normal_pair(&mut self) -> (R, R);
 
     /// Adds `sd` times a standard normal number to each value, in order, a
     /// pair at a time (an odd count leaves the last pair's second unused).
     #[inline(always)]
-    pub fn add_scaled<R: Real<Word = W>>(&mut self, values: &mut [R], sd: f64) {
+    fn add_scaled(&mut self, values: &mut [R], sd: f64) {
         let sd = R::splat(sd);
         for pair in values.chunks_mut(2) {
-            let (a, b) = self.normal_pair::<R>();
+            let (a, b) = self.normal_pair();
             pair[0] = pair[0] + sd * a;
             if let Some(second) = pair.get_mut(1) {
                 *second = *second + sd * b;
             }
         }
+    }
+}
+
+impl<R: Real> Normals<R> for NoiseSource<R::Word> {
+    #[inline(always)]
+    fn normal_pair(&mut self) -> (R, R) {
+        NoiseSource::normal_pair(self)
+    }
+}
+
+/// A lane bundle's noise whose pairs come from `pair`, a function compiled
+/// apart for the caller's SIMD level, instead of being inlined where the
+/// noise is added: the same numbers, in the same order, bit for bit. The
+/// batched kernels draw their noise so, which keeps the Box-Muller
+/// transform (a logarithm, a sine and a cosine on every lane) out of the
+/// inlined flight, whose compile time grew much faster than its size.
+pub struct OutOfLine<'a, const N: usize> {
+    /// The lanes' generators.
+    pub source: &'a mut NoiseSource<Words<N>>,
+    /// `source`'s next pair, for the caller's SIMD level.
+    pub pair: fn(&mut NoiseSource<Words<N>>) -> (Lanes<N>, Lanes<N>),
+}
+
+impl<const N: usize> Normals<Lanes<N>> for OutOfLine<'_, N> {
+    #[inline(always)]
+    fn normal_pair(&mut self) -> (Lanes<N>, Lanes<N>) {
+        (self.pair)(self.source)
     }
 }
 

@@ -20,7 +20,8 @@
 //!
 //! Random starts and the seeds of the noise sources are drawn lane by lane
 //! from each network's own stream, in the scalar path's order; the noise
-//! itself comes from one [`NoiseSource`] per lane, generated in SIMD. A lane
+//! itself comes from one [`NoiseSource`] per lane, generated in SIMD by a
+//! function of its own for each width and level ([`OutOfLine`]). A lane
 //! whose thrust turns NaN (only possible with absurd settings, such as an
 //! input scale that overflows) is re-run on the scalar path, which reports
 //! the error it raises.
@@ -33,7 +34,8 @@ use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use std::ops::Range;
 
 use crate::numeric::{
-    clamp_unit, sigmoid_with, Exponential, Float, LaneMask, Lanes, NoiseSource, Real, SimdLevel, Words,
+    clamp_unit, sigmoid_with, Exponential, Float, LaneMask, Lanes, NoiseSource, Normals, OutOfLine, Real, SimdLevel,
+    Words,
 };
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use esp_neuroevolution::network::{Network, NetworkSet};
@@ -123,7 +125,7 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     flight: &Flight<N>,
     state: &mut PlanarState<Lanes<N>>,
     target: &[Lanes<N>; 3],
-    noise: &mut NoiseSource<Words<N>>,
+    noise: &mut impl Normals<Lanes<N>>,
 ) -> (Lanes<N>, LaneMask<N>) {
     type V<const N: usize> = Lanes<N>;
     assert!(G <= 2 || G >= THRUSTER_COUNT, "groups hold all four outputs");
@@ -292,7 +294,7 @@ fn read_sensors<const N: usize, const NOISY: bool>(
     settings: &PsaSettings,
     state: &PlanarState<Lanes<N>>,
     target: &[Lanes<N>; 3],
-    noise: &mut NoiseSource<Words<N>>,
+    noise: &mut impl Normals<Lanes<N>>,
 ) -> Reading<Lanes<N>> {
     sense::<Lanes<N>, NOISY>(
         settings.step(),
@@ -308,7 +310,9 @@ fn read_sensors<const N: usize, const NOISY: bool>(
 /// `$name`: the kernel of width `$n`, with or without noise, evaluating the
 /// neurons' logistic functions `$group` neurons at a time (see [`fly`]),
 /// compiled for the `multiversion` target `$target` when given, else for
-/// the build's baseline (the portable kernel).
+/// the build's baseline (the portable kernel). A noisy kernel draws its
+/// noise through `[$pair]` ([`OutOfLine`]), compiled for the same target; a
+/// clean one (`[]`) never draws.
 ///
 /// `multiversion` compiles a target's function twice: for the target, and
 /// as a fallback for processors without its features. A target's kernel
@@ -317,7 +321,7 @@ fn read_sensors<const N: usize, const NOISY: bool>(
 /// asked for is missing), so the fallback is `unreachable!`: not another
 /// copy of the whole flight for baseline x86-64.
 macro_rules! kernel {
-    ($name:ident, $target:tt, $n:expr, $group:expr, $noisy:expr) => {
+    ($name:ident, [$($pair:ident)?], $target:tt, $n:expr, $group:expr, $noisy:expr) => {
         #[multiversion(targets($target))]
         fn $name(
             flight: &Flight<$n>,
@@ -326,7 +330,10 @@ macro_rules! kernel {
             noise: &mut NoiseSource<Words<$n>>,
         ) -> (Lanes<$n>, LaneMask<$n>) {
             multiversion::target::match_target! {
-                $target => fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise),
+                $target => {
+                    $(let noise = &mut OutOfLine { source: noise, pair: $pair };)?
+                    fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise)
+                }
                 _ => {
                     let _ = (flight, state, target, noise);
                     unreachable!("a {} kernel called on a processor without it", $target)
@@ -334,14 +341,40 @@ macro_rules! kernel {
             }
         }
     };
-    ($name:ident, $n:expr, $group:expr, $noisy:expr) => {
+    ($name:ident, [$($pair:ident)?], $n:expr, $group:expr, $noisy:expr) => {
         fn $name(
             flight: &Flight<$n>,
             state: &mut PlanarState<Lanes<$n>>,
             target: &[Lanes<$n>; 3],
             noise: &mut NoiseSource<Words<$n>>,
         ) -> (Lanes<$n>, LaneMask<$n>) {
+            $(let noise = &mut OutOfLine { source: noise, pair: $pair };)?
             fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise)
+        }
+    };
+}
+
+/// `$name` (none for `[]`): the next normal pair of every lane of a
+/// [`NoiseSource`] of width `$n`, compiled for the `multiversion` target `$target` when given
+/// (its fallback `unreachable!`, as the kernels'), else for the baseline:
+/// the noisy kernels' [`OutOfLine`] pairs.
+macro_rules! normal_pair {
+    ([], $($ignored:tt)*) => {};
+    ([$name:ident], $target:tt, $n:expr) => {
+        #[multiversion(targets($target))]
+        fn $name(source: &mut NoiseSource<Words<$n>>) -> (Lanes<$n>, Lanes<$n>) {
+            multiversion::target::match_target! {
+                $target => source.normal_pair(),
+                _ => {
+                    let _ = source;
+                    unreachable!("a {} noise generator called on a processor without it", $target)
+                }
+            }
+        }
+    };
+    ([$name:ident], $n:expr) => {
+        fn $name(source: &mut NoiseSource<Words<$n>>) -> (Lanes<$n>, Lanes<$n>) {
+            source.normal_pair()
         }
     };
 }
@@ -353,7 +386,7 @@ macro_rules! kernel {
 /// large function of its own, and the kernels are most of the crate's
 /// compile time (docs/performance.md, "Building").
 macro_rules! kernels {
-    ($module:ident, $n:expr, $noisy:expr, [$(avx512 $g512:expr)?], [$(avx2 $g256:expr)?], [$(portable $portable:ident)?], $avx512:tt, $avx2:tt) => {
+    ($module:ident, $n:expr, $noisy:expr, $pairs:tt, [$(avx512 $g512:expr)?], [$(avx2 $g256:expr)?], [$(portable $portable:ident)?], $avx512:tt, $avx2:tt) => {
         mod $module {
             use super::*;
 
@@ -362,29 +395,32 @@ macro_rules! kernels {
             // after the other, on the build's critical path.
             $(pub(super) mod avx512 {
                 use super::*;
-                kernel!(run, $avx512, $n, $g512, $noisy);
+                normal_pair!($pairs, $avx512, $n);
+                kernel!(run, $pairs, $avx512, $n, $g512, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
             $(pub(super) mod avx2 {
                 use super::*;
-                kernel!(run, $avx2, $n, $g256, $noisy);
+                normal_pair!($pairs, $avx2, $n);
+                kernel!(run, $pairs, $avx2, $n, $g256, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
             $(pub(super) mod $portable {
                 use super::*;
-                kernel!(run, $n, 1, $noisy);
+                normal_pair!($pairs, $n);
+                kernel!(run, $pairs, $n, 1, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
         }
     };
 }
 
-crate::with_simd_targets!(kernels!(wide, LANES, false, [avx512 2], [avx2 1], [],));
-crate::with_simd_targets!(kernels!(wide_noisy, LANES, true, [avx512 2], [avx2 1], [],));
-crate::with_simd_targets!(kernels!(narrow, NARROW_LANES, false, [avx512 5], [], [],));
-crate::with_simd_targets!(kernels!(narrow_noisy, NARROW_LANES, true, [avx512 5], [], [],));
-crate::with_simd_targets!(kernels!(small, SMALL_LANES, false, [], [avx2 1], [portable portable],));
-crate::with_simd_targets!(kernels!(small_noisy, SMALL_LANES, true, [], [avx2 1], [portable portable],));
+crate::with_simd_targets!(kernels!(wide, LANES, false, [], [avx512 2], [avx2 1], [],));
+crate::with_simd_targets!(kernels!(wide_noisy, LANES, true, [pair], [avx512 2], [avx2 1], [],));
+crate::with_simd_targets!(kernels!(narrow, NARROW_LANES, false, [], [avx512 5], [], [],));
+crate::with_simd_targets!(kernels!(narrow_noisy, NARROW_LANES, true, [pair], [avx512 5], [], [],));
+crate::with_simd_targets!(kernels!(small, SMALL_LANES, false, [], [], [avx2 1], [portable portable],));
+crate::with_simd_targets!(kernels!(small_noisy, SMALL_LANES, true, [pair], [], [avx2 1], [portable portable],));
 
 /// A kernel of width N.
 type Kernel<const N: usize> =

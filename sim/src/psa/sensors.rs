@@ -6,7 +6,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use super::task::Target;
-use crate::numeric::{NoiseSource, Real};
+use crate::numeric::{Normals, Real};
 use crate::physics::{wrap_angle, BodyState};
 
 /// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
@@ -141,7 +141,7 @@ impl SensorSettings {
 }
 
 /// Gaussian white noise on the network's inputs (the bias too, if
-/// `on_bias`) and outputs, drawn from a [`NoiseSource`] per trial.
+/// `on_bias`) and outputs, drawn from a [`NoiseSource`](crate::numeric::NoiseSource) per trial.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseSettings {
@@ -165,7 +165,7 @@ impl NoiseSettings {
         self.input_sd > 0.0 || self.output_sd > 0.0
     }
 
-    /// The seed of a trial's [`NoiseSource`]: one word drawn from `rng` when
+    /// The seed of a trial's [`NoiseSource`](crate::numeric::NoiseSource): one word drawn from `rng` when
     /// noise is configured. Without noise nothing is drawn (the source then
     /// goes unused), so noiseless runs consume their streams as before.
     pub fn draw_seed(&self, rng: &mut impl Rng) -> u64 {
@@ -179,7 +179,7 @@ impl NoiseSettings {
     /// Adds input noise to every input but the last (the bias), or to
     /// every one with `on_bias`.
     #[inline(always)]
-    pub fn perturb_inputs<R: Real>(&self, inputs: &mut [R], source: &mut NoiseSource<R::Word>) {
+    pub fn perturb_inputs<R: Real>(&self, inputs: &mut [R], source: &mut impl Normals<R>) {
         if self.input_sd > 0.0 {
             let n = if self.on_bias { inputs.len() } else { inputs.len() - 1 };
             source.add_scaled(&mut inputs[..n], self.input_sd);
@@ -189,7 +189,7 @@ impl NoiseSettings {
     /// Adds output noise; the caller then clamps every output to [0, 1]
     /// ([`clamp_unit`](crate::numeric::clamp_unit)).
     #[inline(always)]
-    pub fn perturb_outputs<R: Real>(&self, outputs: &mut [R], source: &mut NoiseSource<R::Word>) {
+    pub fn perturb_outputs<R: Real>(&self, outputs: &mut [R], source: &mut impl Normals<R>) {
         if self.output_sd > 0.0 {
             source.add_scaled(outputs, self.output_sd);
         }

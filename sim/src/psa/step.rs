@@ -8,7 +8,7 @@ use super::fitness::FitnessSettings;
 use super::fitness::{FitnessState, StepError};
 use super::sensors::INPUT_COUNT;
 use super::sensors::{NoiseSettings, SensorSettings};
-use crate::numeric::{wrap_angle, NoiseSource, Real};
+use crate::numeric::{wrap_angle, Normals, Real};
 
 /// The settings one step reads: how the sensors read and are perturbed,
 /// and how the step is scored.
@@ -42,7 +42,7 @@ pub fn sense<R: Real, const NOISY: bool>(
     heading: R,
     omega: R,
     target: [R; 3],
-    noise: &mut NoiseSource<R::Word>,
+    noise: &mut impl Normals<R>,
 ) -> Reading<R> {
     let heading_error = wrap_angle(heading - target[2]);
     let offset = [position[0] - target[0], position[1] - target[1]];
@@ -110,6 +110,7 @@ mod tests {
     use std::f64::consts::{PI, TAU};
 
     use super::*;
+    use crate::numeric::NoiseSource;
     use crate::psa::sensors::{HeadingInput, HeadingWrap};
 
     /// The settings a step reads, at their defaults.
