@@ -49,8 +49,8 @@ where
 }
 
 /// Writes `drawing` of `size` pixels as SVG and PNG, each atomically: the
-/// SVG drawn into memory, the PNG into a temporary `.png` beside its target
-/// (the encoder picks the format from the extension), then renamed.
+/// SVG drawn into memory, the PNG drawn into an RGB buffer and encoded with
+/// the `png` crate.
 pub(crate) fn write_svg_and_png(
     drawing: &impl Drawing,
     size: (u32, u32),
@@ -67,24 +67,24 @@ pub(crate) fn write_svg_and_png(
             .with_context(|| format!("drawing {}", svg_path.display()))?;
     }
     psa_sim::io::write_atomic(svg_path, svg.as_bytes())?;
-    psa_sim::io::check_output_file(png_path)?;
-    let dir = png_path.parent().unwrap_or(Path::new("."));
-    let name = png_path
-        .file_name()
-        .map_or("figure.png".into(), |s| s.to_string_lossy());
-    // A temporary name of the usual form (so that a killed report's is
-    // cleared by the next), ending in .png for the drawing backend.
-    let tmp = dir.join(format!("{}.png", psa_sim::io::temporary_name(&name)));
-    let drawn = (|| -> Result<()> {
-        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
-        drawing.draw(&root)?;
-        root.present()?;
-        drop(root);
-        std::fs::rename(&tmp, png_path)?;
-        Ok(())
-    })();
-    if drawn.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    let (width, height) = size;
+    let mut pixels = vec![0u8; width as usize * height as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
+        drawing
+            .draw(&root)
+            .with_context(|| format!("drawing {}", png_path.display()))?;
+        root.present()
+            .with_context(|| format!("drawing {}", png_path.display()))?;
     }
-    drawn.with_context(|| format!("writing {}", png_path.display()))
+    psa_sim::io::write_atomic_with(png_path, |out| {
+        let mut encoder = png::Encoder::new(out, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header()?;
+        writer.write_image_data(&pixels)?;
+        writer.finish()?;
+        Ok(())
+    })
+    .with_context(|| format!("writing {}", png_path.display()))
 }
