@@ -90,6 +90,19 @@ impl<const N: usize> BlockWeights<N> {
     }
 }
 
+/// The logistic function of a kernel's blocks of `N` lanes and of its
+/// groups of `NG` lanes ([`fly`]), each compiled apart for the kernel's
+/// SIMD level (`logistic!`) and called, not inlined: every lane goes
+/// through exactly the operations of [`sigmoid_with`], and the flight that
+/// would hold five copies of both exponentials (the setting is read at run
+/// time) compiles in a fraction of the time.
+struct Logistic<const N: usize, const NG: usize> {
+    /// On a block of `N` lanes.
+    single: fn(Lanes<N>, Exponential) -> Lanes<N>,
+    /// On a group of `NG` lanes.
+    group: fn(Lanes<NG>, Exponential) -> Lanes<NG>,
+}
+
 /// Everything one trial of a block needs.
 struct Flight<'a, const N: usize> {
     settings: &'a PsaSettings,
@@ -104,7 +117,7 @@ struct Flight<'a, const N: usize> {
 /// functions run `G` neurons at a time, as one block of `NG = G N` lanes:
 /// `G = 2` in pairs ([`sigmoid_pair`]), `G >= 4` the hidden neurons in groups
 /// of `G` and the four outputs in one group ([`sigmoid_group`]), `G = 1`
-/// one by one. Measured on Zen 5: pairs are faster in the wide AVX-512
+/// one by one, each through `logistic`. Measured on Zen 5: pairs are faster in the wide AVX-512
 /// kernel and slower on AVX2, which has half as many registers; groups of
 /// five made the narrow AVX-512 kernel 16-20 % faster (`psa-esp bench
 /// --networks 16`, two runs).
@@ -126,6 +139,7 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     state: &mut PlanarState<Lanes<N>>,
     target: &[Lanes<N>; 3],
     noise: &mut impl Normals<Lanes<N>>,
+    logistic: &Logistic<N, NG>,
 ) -> (Lanes<N>, LaneMask<N>) {
     type V<const N: usize> = Lanes<N>;
     assert!(G <= 2 || G >= THRUSTER_COUNT, "groups hold all four outputs");
@@ -162,7 +176,12 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
         let (paired, grouped) = (G == 2, G >= THRUSTER_COUNT);
         let mut k = 0;
         while paired && k + 2 <= weights.hidden {
-            let [h0, h1] = sigmoid_pair::<N, NG>(dot(weights, &inputs, k), dot(weights, &inputs, k + 1), e);
+            let [h0, h1] = sigmoid_pair::<N, NG>(
+                dot(weights, &inputs, k),
+                dot(weights, &inputs, k + 1),
+                logistic.group,
+                e,
+            );
             accumulate(weights, &mut outputs, h0, k);
             accumulate(weights, &mut outputs, h1, k + 1);
             k += 2;
@@ -172,29 +191,29 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
             for i in 0..G {
                 net[i] = dot(weights, &inputs, k + i);
             }
-            let h = sigmoid_group::<N, NG, G>(&net, e);
+            let h = sigmoid_group::<N, NG, G>(&net, logistic.group, e);
             for i in 0..G {
                 accumulate(weights, &mut outputs, h[i], k + i);
             }
             k += G;
         }
         for k in k..weights.hidden {
-            let h = sigmoid_with(dot(weights, &inputs, k), e);
+            let h = (logistic.single)(dot(weights, &inputs, k), e);
             accumulate(weights, &mut outputs, h, k);
         }
         if paired {
-            let [o0, o1] = sigmoid_pair::<N, NG>(outputs[0], outputs[1], e);
-            let [o2, o3] = sigmoid_pair::<N, NG>(outputs[2], outputs[3], e);
+            let [o0, o1] = sigmoid_pair::<N, NG>(outputs[0], outputs[1], logistic.group, e);
+            let [o2, o3] = sigmoid_pair::<N, NG>(outputs[2], outputs[3], logistic.group, e);
             outputs = [o0, o1, o2, o3];
         } else if grouped {
             // All four outputs in one group, padded with zeros.
             let mut net = [zero; G];
             net[..THRUSTER_COUNT].copy_from_slice(&outputs);
-            let o = sigmoid_group::<N, NG, G>(&net, e);
+            let o = sigmoid_group::<N, NG, G>(&net, logistic.group, e);
             outputs.copy_from_slice(&o[..THRUSTER_COUNT]);
         } else {
             for o in &mut outputs {
-                *o = sigmoid_with(*o, e);
+                *o = (logistic.single)(*o, e);
             }
         }
         // The logistic function's values lie in [0, 1] already (1 / (1 + e)
@@ -224,12 +243,17 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
 /// parameter only because stable Rust cannot write `Lanes<{ 2 * N }>` in
 /// generic code.)
 #[inline(always)]
-fn sigmoid_pair<const N: usize, const N2: usize>(a: Lanes<N>, b: Lanes<N>, e: Exponential) -> [Lanes<N>; 2] {
+fn sigmoid_pair<const N: usize, const N2: usize>(
+    a: Lanes<N>,
+    b: Lanes<N>,
+    logistic: fn(Lanes<N2>, Exponential) -> Lanes<N2>,
+    e: Exponential,
+) -> [Lanes<N>; 2] {
     assert_eq!(N2, 2 * N, "a pair is two blocks wide");
     let mut both = Lanes::<N2>::splat(0.0);
     both.0[..N].copy_from_slice(&a.0);
     both.0[N..].copy_from_slice(&b.0);
-    let both = sigmoid_with(both, e);
+    let both = logistic(both, e);
     let (mut first, mut second) = (Lanes::<N>::splat(0.0), Lanes::<N>::splat(0.0));
     first.0.copy_from_slice(&both.0[..N]);
     second.0.copy_from_slice(&both.0[N..]);
@@ -241,6 +265,7 @@ fn sigmoid_pair<const N: usize, const N2: usize>(a: Lanes<N>, b: Lanes<N>, e: Ex
 #[inline(always)]
 fn sigmoid_group<const N: usize, const NG: usize, const G: usize>(
     blocks: &[Lanes<N>; G],
+    logistic: fn(Lanes<NG>, Exponential) -> Lanes<NG>,
     e: Exponential,
 ) -> [Lanes<N>; G] {
     assert_eq!(NG, G * N, "a group is G blocks wide");
@@ -248,7 +273,7 @@ fn sigmoid_group<const N: usize, const NG: usize, const G: usize>(
     for i in 0..G {
         all.0[i * N..(i + 1) * N].copy_from_slice(&blocks[i].0);
     }
-    let all = sigmoid_with(all, e);
+    let all = logistic(all, e);
     let mut out = *blocks;
     for i in 0..G {
         out[i].0.copy_from_slice(&all.0[i * N..(i + 1) * N]);
@@ -332,7 +357,8 @@ macro_rules! kernel {
             multiversion::target::match_target! {
                 $target => {
                     $(let noise = &mut OutOfLine { source: noise, pair: $pair };)?
-                    fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise)
+                    let logistic = Logistic { single, group };
+                    fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise, &logistic)
                 }
                 _ => {
                     let _ = (flight, state, target, noise);
@@ -349,7 +375,8 @@ macro_rules! kernel {
             noise: &mut NoiseSource<Words<$n>>,
         ) -> (Lanes<$n>, LaneMask<$n>) {
             $(let noise = &mut OutOfLine { source: noise, pair: $pair };)?
-            fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise)
+            let logistic = Logistic { single, group };
+            fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise, &logistic)
         }
     };
 }
@@ -379,6 +406,30 @@ macro_rules! normal_pair {
     };
 }
 
+/// `$name`: the logistic function ([`sigmoid_with`]) on `$n` lanes,
+/// compiled for the `multiversion` target `$target` when given (its
+/// fallback `unreachable!`, as the kernels'), else for the baseline: a
+/// kernel's [`Logistic`].
+macro_rules! logistic {
+    ($name:ident, $target:tt, $n:expr) => {
+        #[multiversion(targets($target))]
+        fn $name(x: Lanes<{ $n }>, e: Exponential) -> Lanes<{ $n }> {
+            multiversion::target::match_target! {
+                $target => sigmoid_with(x, e),
+                _ => {
+                    let _ = (x, e);
+                    unreachable!("a {} logistic function called on a processor without it", $target)
+                }
+            }
+        }
+    };
+    ($name:ident, $n:expr) => {
+        fn $name(x: Lanes<{ $n }>, e: Exponential) -> Lanes<{ $n }> {
+            sigmoid_with(x, e)
+        }
+    };
+}
+
 /// The kernels of width `$n` (noisy or not), as a module `$module`: for
 /// AVX-512 (the logistic functions `$g512` neurons at a time), AVX2
 /// (`$g256`) and the portable build (one at a time), each only where a
@@ -396,18 +447,24 @@ macro_rules! kernels {
             $(pub(super) mod avx512 {
                 use super::*;
                 normal_pair!($pairs, $avx512, $n);
+                logistic!(single, $avx512, $n);
+                logistic!(group, $avx512, $g512 * $n);
                 kernel!(run, $pairs, $avx512, $n, $g512, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
             $(pub(super) mod avx2 {
                 use super::*;
                 normal_pair!($pairs, $avx2, $n);
+                logistic!(single, $avx2, $n);
+                logistic!(group, $avx2, $g256 * $n);
                 kernel!(run, $pairs, $avx2, $n, $g256, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
             $(pub(super) mod $portable {
                 use super::*;
                 normal_pair!($pairs, $n);
+                logistic!(single, $n);
+                logistic!(group, $n);
                 kernel!(run, $pairs, $n, 1, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
