@@ -90,17 +90,21 @@ impl<const N: usize> BlockWeights<N> {
     }
 }
 
-/// The logistic function of a kernel's blocks of `N` lanes and of its
-/// groups of `NG` lanes ([`fly`]), each compiled apart for the kernel's
-/// SIMD level (`logistic!`) and called, not inlined: every lane goes
-/// through exactly the operations of [`sigmoid_with`], and the flight that
-/// would hold five copies of both exponentials (the setting is read at run
-/// time) compiles in a fraction of the time.
-struct Logistic<const N: usize, const NG: usize> {
-    /// On a block of `N` lanes.
+/// The pieces of a kernel's step that it calls instead of inlining them,
+/// each compiled apart for the kernel's SIMD level (`kernel!`): the flight
+/// that inlined them (five copies of the logistic function with both
+/// exponentials, the Box-Muller transform on every lane in the sensors and
+/// the thrusters) took twice as long to compile, and ran no faster
+/// (docs/performance.md, "Building"). Every lane goes through exactly the
+/// operations it went through inlined.
+struct Parts<const N: usize, const NG: usize> {
+    /// The logistic function ([`sigmoid_with`]) on a block of `N` lanes.
     single: fn(Lanes<N>, Exponential) -> Lanes<N>,
-    /// On a group of `NG` lanes.
+    /// The logistic function on a group of `NG` lanes.
     group: fn(Lanes<NG>, Exponential) -> Lanes<NG>,
+    /// The noise generator's next pair of normal numbers on every lane
+    /// ([`OutOfLine`]), for the noise on the sensors and the thrusters.
+    pair: fn(&mut NoiseSource<Words<N>>) -> (Lanes<N>, Lanes<N>),
 }
 
 /// Everything one trial of a block needs.
@@ -117,7 +121,7 @@ struct Flight<'a, const N: usize> {
 /// functions run `G` neurons at a time, as one block of `NG = G N` lanes:
 /// `G = 2` in pairs ([`sigmoid_pair`]), `G >= 4` the hidden neurons in groups
 /// of `G` and the four outputs in one group ([`sigmoid_group`]), `G = 1`
-/// one by one, each through `logistic`. Measured on Zen 5: pairs are faster in the wide AVX-512
+/// one by one, each through `parts`. Measured on Zen 5: pairs are faster in the wide AVX-512
 /// kernel and slower on AVX2, which has half as many registers; groups of
 /// five made the narrow AVX-512 kernel 16-20 % faster (`psa-esp bench
 /// --networks 16`, two runs).
@@ -138,8 +142,8 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     flight: &Flight<N>,
     state: &mut PlanarState<Lanes<N>>,
     target: &[Lanes<N>; 3],
-    noise: &mut impl Normals<Lanes<N>>,
-    logistic: &Logistic<N, NG>,
+    noise: &mut NoiseSource<Words<N>>,
+    parts: &Parts<N, NG>,
 ) -> (Lanes<N>, LaneMask<N>) {
     type V<const N: usize> = Lanes<N>;
     assert!(G <= 2 || G >= THRUSTER_COUNT, "groups hold all four outputs");
@@ -155,7 +159,8 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     let mut before: Option<Reading<V<N>>> = None;
     let mut previous_omega = zero;
     for step in 0..=s.steps {
-        let reading = read_sensors::<N, NOISY>(s, state, target, noise);
+        let pair = parts.pair;
+        let reading = read_sensors::<N, NOISY>(s, state, target, &mut OutOfLine { source: noise, pair });
         if let Some(before) = &before {
             points = points
                 + score(
@@ -176,12 +181,8 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
         let (paired, grouped) = (G == 2, G >= THRUSTER_COUNT);
         let mut k = 0;
         while paired && k + 2 <= weights.hidden {
-            let [h0, h1] = sigmoid_pair::<N, NG>(
-                dot(weights, &inputs, k),
-                dot(weights, &inputs, k + 1),
-                logistic.group,
-                e,
-            );
+            let [h0, h1] =
+                sigmoid_pair::<N, NG>(dot(weights, &inputs, k), dot(weights, &inputs, k + 1), parts.group, e);
             accumulate(weights, &mut outputs, h0, k);
             accumulate(weights, &mut outputs, h1, k + 1);
             k += 2;
@@ -191,35 +192,37 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
             for i in 0..G {
                 net[i] = dot(weights, &inputs, k + i);
             }
-            let h = sigmoid_group::<N, NG, G>(&net, logistic.group, e);
+            let h = sigmoid_group::<N, NG, G>(&net, parts.group, e);
             for i in 0..G {
                 accumulate(weights, &mut outputs, h[i], k + i);
             }
             k += G;
         }
         for k in k..weights.hidden {
-            let h = (logistic.single)(dot(weights, &inputs, k), e);
+            let h = (parts.single)(dot(weights, &inputs, k), e);
             accumulate(weights, &mut outputs, h, k);
         }
         if paired {
-            let [o0, o1] = sigmoid_pair::<N, NG>(outputs[0], outputs[1], logistic.group, e);
-            let [o2, o3] = sigmoid_pair::<N, NG>(outputs[2], outputs[3], logistic.group, e);
+            let [o0, o1] = sigmoid_pair::<N, NG>(outputs[0], outputs[1], parts.group, e);
+            let [o2, o3] = sigmoid_pair::<N, NG>(outputs[2], outputs[3], parts.group, e);
             outputs = [o0, o1, o2, o3];
         } else if grouped {
             // All four outputs in one group, padded with zeros.
             let mut net = [zero; G];
             net[..THRUSTER_COUNT].copy_from_slice(&outputs);
-            let o = sigmoid_group::<N, NG, G>(&net, logistic.group, e);
+            let o = sigmoid_group::<N, NG, G>(&net, parts.group, e);
             outputs.copy_from_slice(&o[..THRUSTER_COUNT]);
         } else {
             for o in &mut outputs {
-                *o = (logistic.single)(*o, e);
+                *o = (parts.single)(*o, e);
             }
         }
         // The logistic function's values lie in [0, 1] already (1 / (1 + e)
         // with e > 0): clamping changes them only after noise.
         if NOISY {
-            s.noise.perturb_outputs(&mut outputs, noise);
+            let pair = parts.pair;
+            s.noise
+                .perturb_outputs(&mut outputs, &mut OutOfLine { source: noise, pair });
             for o in &mut outputs {
                 *o = clamp_unit(*o);
             }
@@ -332,101 +335,70 @@ fn read_sensors<const N: usize, const NOISY: bool>(
     )
 }
 
-/// `$name`: the kernel of width `$n`, with or without noise, evaluating the
-/// neurons' logistic functions `$group` neurons at a time (see [`fly`]),
-/// compiled for the `multiversion` target `$target` when given, else for
-/// the build's baseline (the portable kernel). A noisy kernel draws its
-/// noise through `[$pair]` ([`OutOfLine`]), compiled for the same target; a
-/// clean one (`[]`) never draws.
+/// `fn $name(..) -> .. $body`, compiled for the `multiversion` target
+/// `$target` when given (`[$target]`), else (`[]`) for the build's baseline
+/// (the portable kernel and its parts).
 ///
 /// `multiversion` compiles a target's function twice: for the target, and
 /// as a fallback for processors without its features. A target's kernel
-/// is only ever called on a processor that has the target
+/// and its parts are only ever called on a processor that has the target
 /// ([`BatchRunner::each_block`] runs the portable kernels where the level
 /// asked for is missing), so the fallback is `unreachable!`: not another
 /// copy of the whole flight for baseline x86-64.
+macro_rules! part {
+    ([$target:tt], fn $name:ident($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty $body:block) => {
+        #[multiversion(targets($target))]
+        fn $name($($arg: $ty),*) -> $ret {
+            multiversion::target::match_target! {
+                $target => $body,
+                _ => {
+                    let _ = ($($arg),*);
+                    unreachable!("{} compiled for {} called on a processor without it", stringify!($name), $target)
+                }
+            }
+        }
+    };
+    ([], fn $name:ident($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty $body:block) => {
+        fn $name($($arg: $ty),*) -> $ret $body
+    };
+}
+
+/// The kernel `run` of width `$n` for the target `$target` (`[]`: the
+/// baseline), with noise if `$noisy`, evaluating the neurons' logistic
+/// functions `$group` neurons at a time (see [`fly`]), and the [`Parts`]
+/// it calls, each compiled for the same target.
 macro_rules! kernel {
-    ($name:ident, [$($pair:ident)?], $target:tt, $n:expr, $group:expr, $noisy:expr) => {
-        #[multiversion(targets($target))]
-        fn $name(
-            flight: &Flight<$n>,
-            state: &mut PlanarState<Lanes<$n>>,
-            target: &[Lanes<$n>; 3],
-            noise: &mut NoiseSource<Words<$n>>,
-        ) -> (Lanes<$n>, LaneMask<$n>) {
-            multiversion::target::match_target! {
-                $target => {
-                    $(let noise = &mut OutOfLine { source: noise, pair: $pair };)?
-                    let logistic = Logistic { single, group };
-                    fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise, &logistic)
-                }
-                _ => {
-                    let _ = (flight, state, target, noise);
-                    unreachable!("a {} kernel called on a processor without it", $target)
-                }
+    ($target:tt, $n:expr, $group:expr, $noisy:expr) => {
+        part!(
+            $target,
+            fn single(x: Lanes<{ $n }>, e: Exponential) -> Lanes<{ $n }> {
+                sigmoid_with(x, e)
             }
-        }
-    };
-    ($name:ident, [$($pair:ident)?], $n:expr, $group:expr, $noisy:expr) => {
-        fn $name(
-            flight: &Flight<$n>,
-            state: &mut PlanarState<Lanes<$n>>,
-            target: &[Lanes<$n>; 3],
-            noise: &mut NoiseSource<Words<$n>>,
-        ) -> (Lanes<$n>, LaneMask<$n>) {
-            $(let noise = &mut OutOfLine { source: noise, pair: $pair };)?
-            let logistic = Logistic { single, group };
-            fly::<$n, { $group * $n }, { $group }, $noisy>(flight, state, target, noise, &logistic)
-        }
-    };
-}
-
-/// `$name` (none for `[]`): the next normal pair of every lane of a
-/// [`NoiseSource`] of width `$n`, compiled for the `multiversion` target `$target` when given
-/// (its fallback `unreachable!`, as the kernels'), else for the baseline:
-/// the noisy kernels' [`OutOfLine`] pairs.
-macro_rules! normal_pair {
-    ([], $($ignored:tt)*) => {};
-    ([$name:ident], $target:tt, $n:expr) => {
-        #[multiversion(targets($target))]
-        fn $name(source: &mut NoiseSource<Words<$n>>) -> (Lanes<$n>, Lanes<$n>) {
-            multiversion::target::match_target! {
-                $target => source.normal_pair(),
-                _ => {
-                    let _ = source;
-                    unreachable!("a {} noise generator called on a processor without it", $target)
-                }
+        );
+        part!(
+            $target,
+            fn group(x: Lanes<{ $group * $n }>, e: Exponential) -> Lanes<{ $group * $n }> {
+                sigmoid_with(x, e)
             }
-        }
-    };
-    ([$name:ident], $n:expr) => {
-        fn $name(source: &mut NoiseSource<Words<$n>>) -> (Lanes<$n>, Lanes<$n>) {
-            source.normal_pair()
-        }
-    };
-}
-
-/// `$name`: the logistic function ([`sigmoid_with`]) on `$n` lanes,
-/// compiled for the `multiversion` target `$target` when given (its
-/// fallback `unreachable!`, as the kernels'), else for the baseline: a
-/// kernel's [`Logistic`].
-macro_rules! logistic {
-    ($name:ident, $target:tt, $n:expr) => {
-        #[multiversion(targets($target))]
-        fn $name(x: Lanes<{ $n }>, e: Exponential) -> Lanes<{ $n }> {
-            multiversion::target::match_target! {
-                $target => sigmoid_with(x, e),
-                _ => {
-                    let _ = (x, e);
-                    unreachable!("a {} logistic function called on a processor without it", $target)
-                }
+        );
+        part!(
+            $target,
+            fn pair(source: &mut NoiseSource<Words<{ $n }>>) -> (Lanes<{ $n }>, Lanes<{ $n }>) {
+                source.normal_pair()
             }
-        }
-    };
-    ($name:ident, $n:expr) => {
-        fn $name(x: Lanes<{ $n }>, e: Exponential) -> Lanes<{ $n }> {
-            sigmoid_with(x, e)
-        }
+        );
+        part!(
+            $target,
+            fn run(
+                flight: &Flight<{ $n }>,
+                state: &mut PlanarState<Lanes<{ $n }>>,
+                target: &[Lanes<{ $n }>; 3],
+                noise: &mut NoiseSource<Words<{ $n }>>,
+            ) -> (Lanes<{ $n }>, LaneMask<{ $n }>) {
+                let parts = Parts { single, group, pair };
+                fly::<{ $n }, { $group * $n }, { $group }, { $noisy }>(flight, state, target, noise, &parts)
+            }
+        );
     };
 }
 
@@ -437,7 +409,7 @@ macro_rules! logistic {
 /// large function of its own, and the kernels are most of the crate's
 /// compile time (docs/performance.md, "Building").
 macro_rules! kernels {
-    ($module:ident, $n:expr, $noisy:expr, $pairs:tt, [$(avx512 $g512:expr)?], [$(avx2 $g256:expr)?], [$(portable $portable:ident)?], $avx512:tt, $avx2:tt) => {
+    ($module:ident, $n:expr, $noisy:expr, [$(avx512 $g512:expr)?], [$(avx2 $g256:expr)?], [$(portable $portable:ident)?], $avx512:tt, $avx2:tt) => {
         mod $module {
             use super::*;
 
@@ -446,38 +418,29 @@ macro_rules! kernels {
             // after the other, on the build's critical path.
             $(pub(super) mod avx512 {
                 use super::*;
-                normal_pair!($pairs, $avx512, $n);
-                logistic!(single, $avx512, $n);
-                logistic!(group, $avx512, $g512 * $n);
-                kernel!(run, $pairs, $avx512, $n, $g512, $noisy);
+                kernel!([$avx512], $n, $g512, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
             $(pub(super) mod avx2 {
                 use super::*;
-                normal_pair!($pairs, $avx2, $n);
-                logistic!(single, $avx2, $n);
-                logistic!(group, $avx2, $g256 * $n);
-                kernel!(run, $pairs, $avx2, $n, $g256, $noisy);
+                kernel!([$avx2], $n, $g256, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
             $(pub(super) mod $portable {
                 use super::*;
-                normal_pair!($pairs, $n);
-                logistic!(single, $n);
-                logistic!(group, $n);
-                kernel!(run, $pairs, $n, 1, $noisy);
+                kernel!([], $n, 1, $noisy);
                 pub(in super::super) const RUN: Kernel<{ $n }> = run;
             })?
         }
     };
 }
 
-crate::with_simd_targets!(kernels!(wide, LANES, false, [], [avx512 2], [avx2 1], [],));
-crate::with_simd_targets!(kernels!(wide_noisy, LANES, true, [pair], [avx512 2], [avx2 1], [],));
-crate::with_simd_targets!(kernels!(narrow, NARROW_LANES, false, [], [avx512 5], [], [],));
-crate::with_simd_targets!(kernels!(narrow_noisy, NARROW_LANES, true, [pair], [avx512 5], [], [],));
-crate::with_simd_targets!(kernels!(small, SMALL_LANES, false, [], [], [avx2 1], [portable portable],));
-crate::with_simd_targets!(kernels!(small_noisy, SMALL_LANES, true, [pair], [], [avx2 1], [portable portable],));
+crate::with_simd_targets!(kernels!(wide, LANES, false, [avx512 2], [avx2 1], [],));
+crate::with_simd_targets!(kernels!(wide_noisy, LANES, true, [avx512 2], [avx2 1], [],));
+crate::with_simd_targets!(kernels!(narrow, NARROW_LANES, false, [avx512 5], [], [],));
+crate::with_simd_targets!(kernels!(narrow_noisy, NARROW_LANES, true, [avx512 5], [], [],));
+crate::with_simd_targets!(kernels!(small, SMALL_LANES, false, [], [avx2 1], [portable portable],));
+crate::with_simd_targets!(kernels!(small_noisy, SMALL_LANES, true, [], [avx2 1], [portable portable],));
 
 /// A kernel of width N.
 type Kernel<const N: usize> =
