@@ -58,25 +58,11 @@ pub(crate) fn write_svg_and_png(
     png_path: &Path,
 ) -> Result<()> {
     let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        drawing
-            .draw(&root)
-            .with_context(|| format!("drawing {}", svg_path.display()))?;
-        root.present()
-            .with_context(|| format!("drawing {}", svg_path.display()))?;
-    }
+    draw_on(drawing, SVGBackend::with_string(&mut svg, size), svg_path)?;
     psa_sim::io::write_atomic(svg_path, svg.as_bytes())?;
     let (width, height) = size;
     let mut pixels = vec![0u8; width as usize * height as usize * 3];
-    {
-        let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
-        drawing
-            .draw(&root)
-            .with_context(|| format!("drawing {}", png_path.display()))?;
-        root.present()
-            .with_context(|| format!("drawing {}", png_path.display()))?;
-    }
+    draw_on(drawing, BitMapBackend::with_buffer(&mut pixels, size), png_path)?;
     psa_sim::io::write_atomic_with(png_path, |out| {
         let mut encoder = png::Encoder::new(out, width, height);
         encoder.set_color(png::ColorType::Rgb);
@@ -87,4 +73,18 @@ pub(crate) fn write_svg_and_png(
         Ok(())
     })
     .with_context(|| format!("writing {}", png_path.display()))
+}
+
+/// Draws `drawing` whole onto `backend` (errors name `path`, the file it is for).
+fn draw_on<DB>(drawing: &impl Drawing, backend: DB, path: &Path) -> Result<()>
+where
+    DB: DrawingBackend,
+    DB::ErrorType: 'static,
+{
+    let root = backend.into_drawing_area();
+    drawing
+        .draw(&root)
+        .with_context(|| format!("drawing {}", path.display()))?;
+    root.present().with_context(|| format!("drawing {}", path.display()))?;
+    Ok(())
 }
