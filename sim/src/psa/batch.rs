@@ -94,8 +94,8 @@ impl<const N: usize> BlockWeights<N> {
 /// each compiled apart for the kernel's SIMD level (`kernel!`): the flight
 /// that inlined them (five copies of the logistic function with both
 /// exponentials, the Box-Muller transform on every lane in the sensors and
-/// the thrusters) took twice as long to compile, and ran no faster
-/// (docs/performance.md, "Building"). Every lane goes through exactly the
+/// the thrusters) made `psa-sim` take 110 s to compile instead of 71 s, and
+/// ran no faster (docs/performance.md, "Building"). Every lane goes through exactly the
 /// operations it went through inlined.
 struct Parts<const N: usize, const NG: usize> {
     /// The logistic function ([`sigmoid_with`]) on a block of `N` lanes.
@@ -121,8 +121,8 @@ struct Flight<'a, const N: usize> {
 /// functions run `G` neurons at a time, as one block of `NG = G N` lanes:
 /// `G = 2` in pairs ([`sigmoid_pair`]), `G >= 4` the hidden neurons in groups
 /// of `G` and the four outputs in one group ([`sigmoid_group`]), `G = 1`
-/// one by one, each through `parts`. Measured on Zen 5: pairs are faster in the wide AVX-512
-/// kernel and slower on AVX2, which has half as many registers; groups of
+/// one by one, each through `parts`. Measured on Zen 5: pairs are faster
+/// in the wide AVX-512 kernel and slower on AVX2, which has half as many registers; groups of
 /// five made the narrow AVX-512 kernel 16-20 % faster (`psa-esp bench
 /// --networks 16`, two runs).
 ///
@@ -158,9 +158,12 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
     // reads the state it starts from and scores the step before it.
     let mut before: Option<Reading<V<N>>> = None;
     let mut previous_omega = zero;
+    let noise = &mut OutOfLine {
+        source: noise,
+        pair: parts.pair,
+    };
     for step in 0..=s.steps {
-        let pair = parts.pair;
-        let reading = read_sensors::<N, NOISY>(s, state, target, &mut OutOfLine { source: noise, pair });
+        let reading = read_sensors::<N, NOISY>(s, state, target, noise);
         if let Some(before) = &before {
             points = points
                 + score(
@@ -220,9 +223,7 @@ fn fly<const N: usize, const NG: usize, const G: usize, const NOISY: bool>(
         // The logistic function's values lie in [0, 1] already (1 / (1 + e)
         // with e > 0): clamping changes them only after noise.
         if NOISY {
-            let pair = parts.pair;
-            s.noise
-                .perturb_outputs(&mut outputs, &mut OutOfLine { source: noise, pair });
+            s.noise.perturb_outputs(&mut outputs, noise);
             for o in &mut outputs {
                 *o = clamp_unit(*o);
             }
