@@ -151,7 +151,6 @@ impl<const N: usize> Normals<Lanes<N>> for OutOfLine<'_, N> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Lanes;
     use super::*;
     use rand::{Rng, SeedableRng};
     use statrs::distribution::{ContinuousCDF, Normal};
