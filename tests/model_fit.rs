@@ -166,6 +166,37 @@ fn the_positive_heading_file_repeats_the_records_of_the_model_before_the_reading
     }
 }
 
+#[test]
+fn the_task2_towards_target_file_repeats_the_records_of_the_refit_byte_for_byte() {
+    // Recorded by build ad8db97, whose defaults the file pins: task 2
+    // starting at 1.0 rad/s, towards its target.
+    let config = "configs/task2-towards-target.toml";
+    assert_repeats_the_golden_records(config, "task2-towards-target", &["baseline", "max-credit"]);
+    // Today's defaults start task 2 elsewhere, and fly another run.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    ok(&psa_esp(&[
+        "evolve",
+        "--task",
+        "2",
+        "--preset",
+        "baseline",
+        "--seed",
+        "7",
+        "--generations",
+        "120",
+        "--backend",
+        "native",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let recorded = std::fs::read(repo("tests/golden/task2-towards-target/baseline-t2.csv")).unwrap();
+    assert!(
+        std::fs::read(out.join("records.csv")).unwrap() != recorded,
+        "task 2's default start did not move"
+    );
+}
+
 /// Asserts that `config` with random starts repeats the records in
 /// `tests/golden/GOLDEN/random-init-tTASK.csv` on tasks 1 and 3 (the tasks
 /// the paper starts at random), byte for byte.

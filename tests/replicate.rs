@@ -295,6 +295,56 @@ fn damaged_or_foreign_run_folders_are_reported_and_left_untouched() {
 }
 
 #[test]
+fn a_run_is_judged_on_the_settings_its_task_reads_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("grid");
+    let args = [
+        "replicate",
+        "--configs",
+        "baseline",
+        "--tasks",
+        "1,2",
+        "--seeds",
+        "1",
+        "--generations",
+        "3",
+        "--robustness-trials",
+        "5",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    assert!(psa_esp(&args).status.success());
+    // Both runs as a build with another task-2 start would have written them.
+    let task1 = dir.join("runs/baseline/task1/seed1");
+    let task2 = dir.join("runs/baseline/task2/seed1");
+    for folder in [&task1, &task2] {
+        let config = std::fs::read_to_string(folder.join("config.toml")).unwrap();
+        let line = config.lines().find(|l| l.starts_with("task2_spin = ")).unwrap();
+        std::fs::write(folder.join("config.toml"), config.replace(line, "task2_spin = 0.3")).unwrap();
+    }
+    let before = results(&dir);
+    let o = psa_esp(&args);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    // Task 2 reads its start: refused, named. Task 1 does not: the same run.
+    assert!(
+        err.contains(task2.to_str().unwrap()) && err.contains("problem.tasks.task2_spin"),
+        "{err}"
+    );
+    assert!(!err.contains(task1.to_str().unwrap()), "{err}");
+    assert!(results(&dir) == before, "a run folder was overwritten");
+    // Without the task-2 run, the grid resumes it and keeps task 1's.
+    std::fs::remove_dir_all(&task2).unwrap();
+    let o = psa_esp(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read_to_string(task1.join("config.toml"))
+        .unwrap()
+        .contains("task2_spin = 0.3"));
+    let o = psa_esp(&["report", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
 fn a_tiny_grid_reports_every_table_and_figure() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("tiny");

@@ -438,3 +438,23 @@ mod per_task {
         assert!(error.contains("task2.steps = 0"), "{error}");
     }
 }
+
+#[test]
+fn each_task_setting_is_read_by_exactly_one_task_and_every_other_setting_by_all() {
+    // Every field of TaskSettings, as a run's config.toml names it: a field
+    // added without its task's `taskN_` prefix fails here.
+    let fields = serde_json::to_value(TaskSettings::default()).unwrap();
+    let fields = fields.as_object().unwrap();
+    assert!(fields.len() >= 8, "{fields:?}");
+    for name in fields.keys() {
+        let setting = format!("problem.tasks.{name}");
+        let readers: Vec<Task> = Task::ALL.into_iter().filter(|t| t.reads_setting(&setting)).collect();
+        assert_eq!(readers.len(), 1, "{setting} is read by {readers:?}");
+        assert!(name.starts_with(&format!("task{}_", readers[0].number())), "{setting}");
+    }
+    assert!(!Task::StopRotation.reads_setting("problem.tasks.task2_spin"));
+    assert!(Task::Turn.reads_setting("problem.tasks.task2_spin"));
+    for setting in ["problem.sensors.heading_wrap", "esp.stagnation", "problem.body.density"] {
+        assert!(Task::ALL.into_iter().all(|t| t.reads_setting(setting)), "{setting}");
+    }
+}

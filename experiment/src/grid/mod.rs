@@ -412,7 +412,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
     match judge {
         Judge::Resume => {
             let found = run_folder_config(&folder)?;
-            let differ = differences(&found, &expected)?;
+            let differ = differences_read_by(key.task, &found, &expected)?;
             if !differ.is_empty() {
                 let shown: Vec<String> = differ
                     .iter()
@@ -432,7 +432,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
             // The run as its own build made it: this grid under that build's
             // defaults (`psa::defaults`); every setting must agree.
             if let Ok(at_build) = spec.run_config_at(key.config, &folder_placement(&folder)) {
-                let differ = differences(&found, &at_build)?;
+                let differ = differences_read_by(key.task, &found, &at_build)?;
                 if !differ.is_empty() {
                     let shown: Vec<String> = differ
                         .iter()
@@ -450,7 +450,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
             // A build that cannot be placed: every setting whose default never
             // changed (no row in `psa::defaults`) holds at any build.
             let changed_ever = |setting: &str| psa_sim::psa::defaults::CHANGES.iter().any(|c| c.key == setting);
-            if let Some((setting, there, here)) = differences(&found, &expected)?
+            if let Some((setting, there, here)) = differences_read_by(key.task, &found, &expected)?
                 .into_iter()
                 .find(|(setting, _, _)| !changed_ever(setting))
             {
@@ -462,6 +462,9 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
             }
             // And the settings grid.json states.
             for setting in spec.stated_keys(key.config)? {
+                if !key.task.reads_setting(&setting) {
+                    continue;
+                }
                 let (there, here) = (leaf(&found, &setting)?, leaf(&expected, &setting)?);
                 if there != here {
                     bail!(
@@ -595,6 +598,16 @@ pub fn differences(a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, 
             differ.push((key.clone(), "nothing".into(), value.to_string()));
         }
     }
+    Ok(differ)
+}
+
+/// [`differences`] in the settings a run of `task` reads: a task-1 run
+/// written under another task-2 start is the same run
+/// ([`Task::reads_setting`]), so a grid whose task 2 changed keeps its
+/// task-1 and task-3 runs.
+fn differences_read_by(task: Task, a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, String)>> {
+    let mut differ = differences(a, b)?;
+    differ.retain(|(setting, _, _)| task.reads_setting(setting));
     Ok(differ)
 }
 

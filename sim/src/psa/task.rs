@@ -38,6 +38,21 @@ impl Task {
         }
     }
 
+    /// Whether a run of this task reads `setting`, a dotted key of a run's
+    /// configuration (`problem.tasks.task2_spin`): each task reads only its
+    /// own `[problem.tasks]` settings (`taskN_...`, see [`TaskSettings`]),
+    /// so a run of task 1 is the same run whatever task 2's start; every
+    /// other setting is read by every task.
+    pub fn reads_setting(self, setting: &str) -> bool {
+        match setting.strip_prefix("problem.tasks.") {
+            Some(name) => name
+                .strip_prefix("task")
+                .and_then(|rest| rest.split('_').next())
+                .is_some_and(|n| n == self.number().to_string()),
+            None => true,
+        }
+    }
+
     /// Whether the paper ran this task (its tables have a column for it): a
     /// grid's default tasks and the report's comparisons with the paper ask
     /// this, never [`Task::ALL`]. A task added later answers `false`.
@@ -105,9 +120,10 @@ pub struct TaskSettings {
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
     /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
-    /// turning when the trial starts. `[fitted]` 1.0: the paper's Table 1
-    /// and 2 levels for task 2, their spreads and its burst totals
-    /// (docs/model.md, sweeps S18 and S24)
+    /// turning when the trial starts. `[fitted]` -1.5, clockwise, away from
+    /// the target: the whole distance to the paper (Table 1 and 2 for task
+    /// 2 with their spreads, the burst totals and their ratio; docs/model.md,
+    /// sweeps S24 and S33-S35)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
@@ -130,7 +146,7 @@ impl Default for TaskSettings {
         TaskSettings {
             task1_spin: 1.0,
             task2_target_heading: FRAC_PI_2,
-            task2_spin: 1.0,
+            task2_spin: -1.5,
             task2_velocity: [0.0, 0.0],
             task3_speed: 0.4,
             task3_distance: 0.40,
