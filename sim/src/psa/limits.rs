@@ -4,7 +4,7 @@
 //! or `start.*` for the start state `simulate --start` takes), its range and
 //! why; a sensible experiment never leaves it (a real PSA is a softball- to
 //! volleyball-sized robot with 1 N thrusters; the paper's tasks start with
-//! spins of about 1 rad/s and speeds of up to 0.4 m/s and step at 0.05 s).
+//! spins of 1 to 1.5 rad/s and speeds of up to 0.4 m/s and step at 0.05 s).
 //! Settings are checked against it when a configuration or the command line
 //! is read, with an error naming the key, the value and the range. Within
 //! these ranges no trial comes near what the physics engines cannot
@@ -47,7 +47,8 @@ const SPEED: [f64; 2] = [-10.0, 10.0];
 const SPEED_WHY: &str = "the tasks start at up to 0.4 m/s, the fastest flight mode of NASA's Astrobee; 1 N thrusters on a 3 kg body give 0.7 m/s^2";
 /// Angular velocities (rad/s).
 const SPIN: [f64; 2] = [-100.0, 100.0];
-const SPIN_WHY: &str = "the start spins fitted to the paper are about 1 rad/s; 100 rad/s is 16 turns a second";
+const SPIN_WHY: &str =
+    "the start spins fitted to the paper are 1 to 1.5 rad/s either way; 100 rad/s is 16 turns a second";
 /// Input scalings (input units per SI unit) and the bias input.
 const SCALE: [f64; 2] = [-1000.0, 1000.0];
 const SCALE_WHY: &str =
