@@ -82,27 +82,8 @@ fn assert_repeats_the_golden_records(config: &str, golden: &str, presets: &[&str
 /// `tests/golden/GOLDEN/LABEL-tTASK.csv` on `task`, byte for byte (seed 7,
 /// 120 generations, native).
 fn assert_repeats_one_golden_record(config: &Path, golden: &str, preset: &str, label: &str, task: &str) {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("run");
-    ok(&psa_esp(&[
-        "evolve",
-        "--task",
-        task,
-        "--preset",
-        preset,
-        "--seed",
-        "7",
-        "--generations",
-        "120",
-        "--backend",
-        "native",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    let records = golden_run_records(Some(config), preset, task);
     let recorded = std::fs::read(repo(&format!("tests/golden/{golden}/{label}-t{task}.csv"))).unwrap();
-    let records = std::fs::read(out.join("records.csv")).unwrap();
     assert!(
         records == recorded,
         "{label} task {task}: records.csv differs from the one recorded in tests/golden/{golden}"
@@ -173,14 +154,24 @@ fn the_task2_towards_target_file_repeats_the_records_of_the_refit_byte_for_byte(
     let config = "configs/task2-towards-target.toml";
     assert_repeats_the_golden_records(config, "task2-towards-target", &["baseline", "max-credit"]);
     // Today's defaults start task 2 elsewhere, and fly another run.
+    let recorded = std::fs::read(repo("tests/golden/task2-towards-target/baseline-t2.csv")).unwrap();
+    assert!(
+        golden_run_records(None, "baseline", "2") != recorded,
+        "task 2's default start did not move"
+    );
+}
+
+/// The `records.csv` of the golden records' run (seed 7, 120 generations,
+/// native) of `preset` on `task`, with `config` laid over it if given.
+fn golden_run_records(config: Option<&Path>, preset: &str, task: &str) -> Vec<u8> {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    ok(&psa_esp(&[
+    let mut args = vec![
         "evolve",
         "--task",
-        "2",
+        task,
         "--preset",
-        "baseline",
+        preset,
         "--seed",
         "7",
         "--generations",
@@ -189,12 +180,12 @@ fn the_task2_towards_target_file_repeats_the_records_of_the_refit_byte_for_byte(
         "native",
         "--out",
         out.to_str().unwrap(),
-    ]));
-    let recorded = std::fs::read(repo("tests/golden/task2-towards-target/baseline-t2.csv")).unwrap();
-    assert!(
-        std::fs::read(out.join("records.csv")).unwrap() != recorded,
-        "task 2's default start did not move"
-    );
+    ];
+    if let Some(config) = config {
+        args.extend(["--config", config.to_str().unwrap()]);
+    }
+    ok(&psa_esp(&args));
+    std::fs::read(out.join("records.csv")).unwrap()
 }
 
 /// Asserts that `config` with random starts repeats the records in

@@ -33,6 +33,26 @@ fn grid_args(out: &Path) -> Vec<String> {
     .collect()
 }
 
+/// A tiny baseline grid on `tasks` with `seeds` seeds (3 generations, 5
+/// robustness trials), written to `out`.
+fn tiny_baseline_grid<'a>(tasks: &'a str, seeds: &'a str, out: &'a Path) -> [&'a str; 13] {
+    [
+        "replicate",
+        "--configs",
+        "baseline",
+        "--tasks",
+        tasks,
+        "--seeds",
+        seeds,
+        "--generations",
+        "3",
+        "--robustness-trials",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]
+}
+
 /// Every result file of every run folder, by relative path (provenance
 /// times in run.json excluded: they say when, not what).
 fn results(dir: &Path) -> Vec<(String, Vec<u8>)> {
@@ -245,21 +265,7 @@ fn a_grid_in_lockstep_writes_the_files_of_run_by_run_byte_for_byte() {
 fn damaged_or_foreign_run_folders_are_reported_and_left_untouched() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("grid");
-    let args = [
-        "replicate",
-        "--configs",
-        "baseline",
-        "--tasks",
-        "2",
-        "--seeds",
-        "3",
-        "--generations",
-        "3",
-        "--robustness-trials",
-        "5",
-        "--out",
-        dir.to_str().unwrap(),
-    ];
+    let args = tiny_baseline_grid("2", "3", &dir);
     assert!(psa_esp(&args).status.success());
     let seed1 = dir.join("runs/baseline/task2/seed1");
     let seed2 = dir.join("runs/baseline/task2/seed2");
@@ -298,21 +304,7 @@ fn damaged_or_foreign_run_folders_are_reported_and_left_untouched() {
 fn a_run_is_judged_on_the_settings_its_task_reads_only() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("grid");
-    let args = [
-        "replicate",
-        "--configs",
-        "baseline",
-        "--tasks",
-        "1,2",
-        "--seeds",
-        "1",
-        "--generations",
-        "3",
-        "--robustness-trials",
-        "5",
-        "--out",
-        dir.to_str().unwrap(),
-    ];
+    let args = tiny_baseline_grid("1,2", "1", &dir);
     assert!(psa_esp(&args).status.success());
     // Both runs as a build with another task-2 start would have written them.
     let task1 = dir.join("runs/baseline/task1/seed1");

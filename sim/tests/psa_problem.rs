@@ -295,7 +295,8 @@ fn start_states_and_targets_are_as_specified() {
         (s2, g2),
         (
             BodyState {
-                omega: 1.0,
+                // Clockwise, away from the target heading.
+                omega: -1.5,
                 ..BodyState::default()
             },
             Target {
