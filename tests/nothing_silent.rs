@@ -887,6 +887,9 @@ fn docs_limits_states_the_rules_for_output_paths_and_checkpoints() {
         "io::check_output_file",
         "io::create_output_dir",
         "io::remove_stale_temporaries",
+        "## Settings a task does not read",
+        "Task::reads_setting",
+        "damaged, not a saved run",
     ] {
         assert!(doc.contains(needle), "docs/limits.md lacks {needle:?}");
     }
@@ -909,4 +912,241 @@ fn docs_limits_states_the_rules_for_output_paths_and_checkpoints() {
         .trim_start_matches("error: ")
         .replace(fifo.to_str().unwrap(), "/tmp/x.csv");
     assert!(doc.contains(&quoted), "docs/limits.md should quote {quoted:?}");
+}
+
+// Round two (issue 66): a run is judged on the settings its own task
+// reads (`Task::reads_setting`), in every command.
+
+/// A finished tiny grid of task 2 alone in `dir/name`.
+fn task_2_grid(dir: &Path, name: &str) -> PathBuf {
+    let out = dir.join(name);
+    let mut args = tiny_args(&out);
+    let at = args.iter().position(|a| *a == "--tasks").unwrap();
+    args[at + 1] = "2";
+    ok(&psa_esp(&args));
+    out
+}
+
+/// Sets the `overrides` of the grid in `grid` (its grid.json) to `toml`.
+fn set_grid_overrides(grid: &Path, toml: &str) {
+    let path = grid.join("grid.json");
+    let mut spec: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    spec["overrides"] = toml.into();
+    std::fs::write(&path, serde_json::to_string_pretty(&spec).unwrap()).unwrap();
+}
+
+/// `report --format json` of `grid` (exit 1 when a run is not counted),
+/// and its report.json.
+fn report_json(grid: &Path) -> serde_json::Value {
+    let o = psa_esp(&["report", grid.to_str().unwrap(), "--format", "json"]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr(&o));
+    serde_json::from_str(&std::fs::read_to_string(grid.join("report.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn a_rescoring_setting_no_task_of_the_grid_reads_is_refused_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = copy_of_grid(dir.path());
+    for (toml, key) in [
+        ("[problem.tasks]\ntask2_spin = 1.0\n", "problem.tasks.task2_spin"),
+        ("[problem.tasks]\ntask2_velocity = [0.1, 0.0]\n", "problem.tasks.task2_velocity"),
+        ("[problem.task2]\nsteps = 100\n", "problem.task2.steps"),
+    ] {
+        let config = dir.path().join("rescore.toml");
+        std::fs::write(&config, toml).unwrap();
+        let out = dir.path().join("rescored");
+        refused(
+            &psa_esp(&[
+                "rescore",
+                source.to_str().unwrap(),
+                "--config",
+                config.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ]),
+            &[key, "changes nothing"],
+        );
+        assert!(!out.exists(), "{key}: nothing written");
+    }
+}
+
+#[test]
+fn a_sweep_of_a_setting_no_task_of_the_grid_reads_is_refused_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for (vary, key) in [
+        ("problem.tasks.task2_spin=1.0,-1.5", "problem.tasks.task2_spin"),
+        ("problem.task2.steps=100,200", "problem.task2.steps"),
+    ] {
+        let out = dir.path().join("sweep");
+        refused(&psa_esp(&tiny_sweep(&out, "1", &[vary])), &[key, "changes nothing"]);
+        assert!(!out.exists(), "{vary}: nothing written");
+    }
+}
+
+#[test]
+fn a_task_2_run_of_another_start_whose_build_cannot_be_placed_is_not_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = task_2_grid(dir.path(), "grid");
+    let folder = run_dir(
+        &grid,
+        &RunKey {
+            config: "baseline".parse().unwrap(),
+            task: Task::Turn,
+            seed: 1,
+        },
+    );
+    let config = folder.join("config.toml");
+    let mut table: toml::Table = toml::from_str(&std::fs::read_to_string(&config).unwrap()).unwrap();
+    table["problem"]["tasks"]["task2_spin"] = toml::Value::Float(1.0);
+    std::fs::write(&config, toml::to_string(&table).unwrap()).unwrap();
+    let path = folder.join("run.json");
+    let mut run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let build = run["build"].as_object_mut().unwrap();
+    build.remove("defaults");
+    build.insert("git_commit".into(), "0123456789abcdef0123456789abcdef01234567".into());
+    std::fs::write(&path, serde_json::to_string_pretty(&run).unwrap()).unwrap();
+    let report = report_json(&grid);
+    assert_eq!(report["runs_counted"], 0, "{report}");
+    let problems = report["problems"].to_string();
+    assert!(problems.contains("problem.tasks.task2_spin"), "{problems}");
+}
+
+#[test]
+fn a_task_1_run_is_judged_without_the_problem_task2_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let toml = "[problem.task2]\nsteps = 100\n";
+    set_grid_overrides(&grid, toml);
+    let report = report_json(&grid);
+    assert_eq!(report["runs_counted"], 1, "{report}");
+    assert_eq!(report["problems"], serde_json::json!([]), "{report}");
+    // Resumed with that table: the task-1 run is finished, not refused.
+    let config = dir.path().join("task2.toml");
+    std::fs::write(&config, toml).unwrap();
+    let mut args = tiny_args(&grid);
+    args.extend(["--config", config.to_str().unwrap()]);
+    ok(&psa_esp(&args));
+}
+
+#[test]
+fn report_md_lists_every_setting_a_grid_changes_from_the_defaults() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    ok(&psa_esp(&["report", grid.to_str().unwrap()]));
+    let plain = std::fs::read_to_string(grid.join("report.md")).unwrap();
+    assert!(!plain.contains("changed from the defaults"), "{plain}");
+    let toml = std::fs::read_to_string(repo("configs/task2-towards-target.toml")).unwrap();
+    set_grid_overrides(&grid, &toml);
+    ok(&psa_esp(&["report", grid.to_str().unwrap()]));
+    let md = std::fs::read_to_string(grid.join("report.md")).unwrap();
+    assert!(
+        md.contains("`problem.tasks.task2_spin = 1.0` (default -1.5)"),
+        "report.md should name the setting: {md}"
+    );
+}
+
+#[test]
+fn a_huge_vary_list_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let list = |key: &str, n: usize| {
+        let values: Vec<String> = (1..=n).map(|i| i.to_string()).collect();
+        format!("{key}={}", values.join(","))
+    };
+    let long = list("esp.stagnation", 20_000);
+    let mut args = tiny_sweep(&out, "1", &[&long]);
+    args.extend(["--mode", "one-at-a-time"]);
+    let o = run_within(&args, Duration::from_secs(20)).expect("refused within 20 s");
+    refused(&o, &["esp.stagnation", "at most 10000"]);
+    // 10^12 variants of four lists of 1000 values: counted, not compared.
+    let lists: Vec<String> = ["esp.stagnation", "esp.burst_scale", "problem.steps", "esp.lesion_threshold"]
+        .iter()
+        .map(|k| list(k, 1000))
+        .collect();
+    let vary: Vec<&str> = lists.iter().map(String::as_str).collect();
+    let o = run_within(&tiny_sweep(&out, "1", &vary), Duration::from_secs(20)).expect("refused within 20 s");
+    refused(&o, &["1000000000000 variants"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn every_damaged_checkpoint_is_refused_by_one_rule() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let folder = run_folder(&grid);
+    std::fs::remove_file(folder.join("robustness.json")).unwrap();
+    let checkpoint = folder.join("checkpoint.json");
+    let mut args = tiny_args(&grid);
+    args.push("--lockstep");
+    for (what, bytes) in [
+        ("zeroed", vec![0u8; 4096]),
+        ("truncated", b"{\"Esp\":{\"records\":[".to_vec()),
+        ("empty", Vec::new()),
+        ("garbage", vec![0xff, 0xfe, 0x00, 0x41]),
+    ] {
+        std::fs::write(&checkpoint, &bytes).unwrap();
+        let o = run_within(&args, Duration::from_secs(60)).unwrap_or_else(|| panic!("{what}: hangs"));
+        refused(&o, &["checkpoint.json", "remove it to start the run afresh"]);
+        assert!(!folder.join("robustness.json").exists(), "{what}: the run was not run");
+        std::fs::remove_file(&checkpoint).unwrap();
+    }
+}
+
+#[test]
+fn a_speedup_floor_over_too_few_networks_to_batch_is_refused() {
+    let o = psa_esp(&["bench", "--speedup-floor", "4", "--networks", "1"]);
+    refused(&o, &["--networks 1", "nothing to batch"]);
+}
+
+#[test]
+fn a_run_json_that_does_not_parse_is_named_not_config_toml() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    // A run of an earlier build: its config.toml needs run.json's build.
+    age_run(&grid, "a70d696");
+    let path = run_folder(&grid).join("run.json");
+    let mut run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    run["champion_fitness"] = "HUGE".into();
+    let text = serde_json::to_string_pretty(&run).unwrap().replace("\"HUGE\"", "1e999");
+    std::fs::write(&path, text).unwrap();
+    let report = report_json(&grid);
+    assert_eq!(report["runs_counted"], 0, "{report}");
+    let problems = report["problems"].to_string();
+    assert!(
+        problems.contains("run.json: damaged") && !problems.contains("config.toml"),
+        "{problems}"
+    );
+    // Resuming names run.json, not config.toml.
+    let text = refused(&psa_esp(&tiny_args(&grid)), &["run.json", "damaged"]);
+    assert!(!text.contains("config.toml") && !text.contains("not written"), "{text}");
+}
+
+#[test]
+fn a_network_file_without_provenance_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let champion = run_folder(&grid).join("champion.json");
+    let mut json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&champion).unwrap()).unwrap();
+    json.as_object_mut().unwrap().remove("provenance");
+    json["problem"]["sensors"].as_object_mut().unwrap().remove("heading_wrap");
+    let file = dir.path().join("bare.json");
+    std::fs::write(&file, json.to_string()).unwrap();
+    refused(
+        &psa_esp(&["replay", file.to_str().unwrap()]),
+        &["heading_wrap", "no \"provenance\""],
+    );
+}
+
+#[test]
+fn evolve_refuses_a_folder_name_that_is_not_utf8() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join(std::ffi::OsStr::from_bytes(b"run-\xff"));
+    let o = Command::new(common::binary())
+        .args(["evolve", "--task", "1", "--generations", "2", "--backend", "native", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    refused(&o, &["not UTF-8"]);
+    assert!(!out.exists());
 }

@@ -196,12 +196,13 @@ pub(crate) fn remove_checkpoint(folder: &Path) -> Result<()> {
 }
 
 /// The run that `folder`'s checkpoint saved, when there is one of the
-/// same search as `fresh` (else `fresh`: a checkpoint that does not parse
-/// or is of another search is ignored, with a warning). A checkpoint is an
+/// same search as `fresh` (else `fresh`: a checkpoint of another search is
+/// ignored, with a warning). A checkpoint is an
 /// input file as any other (docs/limits.md): anything but a regular file
 /// (a FIFO, a link, a directory, a device) or a file over
 /// [`psa_sim::io::MAX_INPUT_BYTES`] is refused, and the run with it, by an
-/// error naming it, before the run starts.
+/// error naming it, before the run starts; so is every damaged one
+/// (garbage, not UTF-8, zeroed, truncated, empty): one rule for all damage.
 fn resume(folder: &Path, fresh: AnyRun) -> Result<AnyRun> {
     let file = folder.join(CHECKPOINT);
     match std::fs::symlink_metadata(&file) {
@@ -232,10 +233,10 @@ fn resume(folder: &Path, fresh: AnyRun) -> Result<AnyRun> {
             log::warn!("{}: of another search, ignored", file.display());
             fresh
         }
-        Err(e) => {
-            log::warn!("{}: cannot be read ({e}), ignored", file.display());
-            fresh
-        }
+        Err(e) => anyhow::bail!(
+            "{}: damaged, not a saved run ({e}); remove it to start the run afresh",
+            file.display()
+        ),
     })
 }
 

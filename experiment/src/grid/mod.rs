@@ -431,7 +431,24 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
             let found = run_folder_config(&folder)?;
             // The run as its own build made it: this grid under that build's
             // defaults (`psa::defaults`); every setting must agree.
-            if let Ok(at_build) = spec.run_config_at(key.config, &folder_placement(&folder)) {
+            let placement = folder_placement(&folder);
+            if let psa_sim::psa::defaults::Placement::Unknown(why) = &placement {
+                // A finished run whose run.json names no build this build
+                // can place: no earlier defaults can vouch for it, so each
+                // setting its task reads must be this grid's.
+                if RunFiles::in_dir(&folder).summary.exists() {
+                    if let Some((setting, there, here)) =
+                        differences_read_by(key.task, &found, &expected)?.into_iter().next()
+                    {
+                        bail!(
+                            "{}: holds a different configuration than {} in this grid: {setting} = {there} there, {here} in this grid, and its build cannot be placed ({why}) to show that build's defaults gave it (another grid's run?); move it away",
+                            folder.display(),
+                            key.config,
+                        );
+                    }
+                }
+            }
+            if let Ok(at_build) = spec.run_config_at(key.config, &placement) {
                 let differ = differences_read_by(key.task, &found, &at_build)?;
                 if !differ.is_empty() {
                     let shown: Vec<String> = differ
@@ -499,6 +516,14 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
 pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
     let path = RunFiles::in_dir(folder).config;
     let text = psa_sim::io::read_input(&path, "run configuration")?;
+    // The run.json that names the build is read first: a damaged one is
+    // named itself, not blamed on config.toml.
+    let summary = RunFiles::in_dir(folder).summary;
+    if summary.exists() {
+        let json = psa_sim::io::read_input(&summary, "run summary")?;
+        serde_json::from_str::<serde_json::Value>(&json)
+            .with_context(|| format!("{}: damaged file, so the build that wrote the run is unknown", summary.display()))?;
+    }
     let damaged = || format!("{}: damaged configuration", path.display());
     let table: toml::Table = toml::from_str(&text).with_context(damaged)?;
     let mut doc = serde_json::to_value(&table).with_context(damaged)?;
@@ -516,6 +541,7 @@ fn folder_placement(folder: &Path) -> psa_sim::psa::defaults::Placement {
     use psa_sim::psa::defaults::Placement;
     match EvolveOutcome::build_of(&RunFiles::in_dir(folder).summary) {
         Some(serde_json::Value::Object(build)) => Placement::of_json(Some(&build)),
+        _ if RunFiles::in_dir(folder).summary.exists() => Placement::Unknown("its run.json names no build".into()),
         _ => Placement::Unknown("its run.json, which names its build, is not written (yet)".into()),
     }
 }
@@ -560,6 +586,19 @@ fn leaves(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)
             other => out.push((path, other.clone())),
         }
     }
+}
+
+/// Every setting of `config` a run of `task` reads
+/// ([`Task::reads_setting`]), one `key = value` line each: two
+/// configurations with the same lines make the same runs of `task`.
+pub fn settings_read_by(task: Task, config: &RunConfig) -> Result<String> {
+    let mut all = Vec::new();
+    leaves(&toml::Table::try_from(config)?, "", &mut all);
+    Ok(all
+        .into_iter()
+        .filter(|(key, _)| task.reads_setting(key))
+        .map(|(key, value)| format!("{key} = {value}\n"))
+        .collect())
 }
 
 /// The value of the dotted `key` in `config` (`None` when absent).

@@ -117,12 +117,13 @@ fn check_each_setting_acts(
                 .with_context(|| format!("the rescoring setting {alone}"))?;
             for &task in source.tasks.iter().filter(|&&t| config.applies_to(t)) {
                 let tested = |c: &crate::RunConfig| crate::champion::robustness::tested_settings(&c.problem, task);
-                acts |= tested(before)? != tested(&after)?;
+                acts |= task.reads_setting(&key) && tested(before)? != tested(&after)?;
             }
         }
         if !acts {
             bail!(
-                "the rescoring setting {alone} changes nothing the robustness tests fly: they set their own input and output noise, random starts and trials, and score on fitness.scoring (the fitness evolved on only with scoring = \"evolution\")"
+                "the rescoring setting {alone} changes nothing the robustness tests fly on this grid's tasks ({}): a task reads only its own [problem.tasks] keys and [problem.taskN] table; the tests set their own input and output noise, random starts and trials, and score on fitness.scoring (the fitness evolved on only with scoring = \"evolution\")",
+                source.tasks.iter().map(|t| t.to_string()).collect::<Vec<_>>().join(", ")
             );
         }
     }

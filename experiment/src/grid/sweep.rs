@@ -117,16 +117,27 @@ pub fn parse_vary(text: &str) -> Result<Vary> {
         current.push(c);
     }
     parts.push(current);
+    // One list alone makes as many variants as it has values (in either
+    // mode): counted before any value is parsed.
+    if parts.len() > MAX_VARIANTS {
+        bail!(
+            "--vary {key}: {} values make {} variants or more; at most {MAX_VARIANTS} are allowed",
+            parts.len(),
+            parts.len()
+        );
+    }
     let values: Vec<String> = parts.iter().map(|v| toml_value(v.trim())).collect::<Result<_>>()?;
     if values.iter().any(|v| v.is_empty()) {
         bail!("--vary {text:?}: an empty value");
     }
-    for (i, value) in values.iter().enumerate() {
-        if let Some(earlier) = values[..i].iter().find(|e| same_value(e, value)) {
+    // Each value once, in linear time: by its canonical form.
+    let mut seen: std::collections::HashMap<String, &String> = std::collections::HashMap::new();
+    for value in &values {
+        if let Some(earlier) = seen.insert(canonical_value(value), value) {
             if earlier == value {
-                bail!("--vary {text:?}: the value {value} is given twice");
+                bail!("--vary {key}: the value {value} is given twice");
             }
-            bail!("--vary {text:?}: the values {earlier} and {value} are the same value");
+            bail!("--vary {key}: the values {earlier} and {value} are the same value");
         }
     }
     Ok(Vary {
@@ -135,24 +146,23 @@ pub fn parse_vary(text: &str) -> Result<Vary> {
     })
 }
 
-/// Whether two TOML values (as [`toml_value`] writes them) are the same
-/// value: `1` and `1.0` are, as are arrays of such.
-fn same_value(a: &str, b: &str) -> bool {
-    fn parse(text: &str) -> Option<toml::Value> {
-        format!("v = {text}").parse::<toml::Table>().ok()?.remove("v")
-    }
-    fn same(a: &toml::Value, b: &toml::Value) -> bool {
+/// A TOML value (as [`toml_value`] writes it) in one form per value:
+/// `1` and `1.0` are one value (as are `0.0` and `-0.0`), as are arrays
+/// of such, so two values are the same value when their forms are equal.
+fn canonical_value(text: &str) -> String {
+    fn form(value: &toml::Value) -> String {
         use toml::Value::{Array, Float, Integer};
-        match (a, b) {
-            (Integer(x), Float(y)) | (Float(y), Integer(x)) => *x as f64 == *y,
-            (Float(x), Float(y)) => x == y,
-            (Array(x), Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same(x, y)),
-            _ => a == b,
+        match value {
+            Integer(x) => x.to_string(),
+            Float(x) if x.fract() == 0.0 && x.abs() < 9.2e18 => (*x as i64).to_string(),
+            Float(x) => format!("{x:?}"),
+            Array(items) => format!("[{}]", items.iter().map(form).collect::<Vec<_>>().join(",")),
+            other => other.to_string(),
         }
     }
-    match (parse(a), parse(b)) {
-        (Some(x), Some(y)) => same(&x, &y),
-        _ => a == b,
+    match format!("v = {text}").parse::<toml::Table>() {
+        Ok(mut table) => table.remove("v").map_or_else(|| text.to_string(), |v| form(&v)),
+        Err(_) => text.to_string(),
     }
 }
 
@@ -416,8 +426,13 @@ fn grid_identity(grid: &GridSpec) -> Result<String> {
         overrides: None,
         ..grid.clone()
     })?;
+    // Each run judged on the settings its task reads: a variant that
+    // changes only task 2's start runs the same runs in a task-1 grid.
     for &config in &grid.configs {
-        identity.push_str(&grid.run_config(config)?.to_toml()?);
+        let run = grid.run_config(config)?;
+        for &task in grid.tasks.iter().filter(|&&t| config.applies_to(t)) {
+            identity.push_str(&crate::grid::settings_read_by(task, &run)?);
+        }
     }
     Ok(identity)
 }

@@ -161,6 +161,23 @@ fn grid_section(md: &mut String, report: &Report) {
     if !report.readings.is_empty() {
         let _ = writeln!(md, "| readings | {} |", report.readings.join("; "));
     }
+    // Every setting the grid's own overrides (`--config`) change from the
+    // defaults, so that report.md alone tells two such grids apart.
+    if let Some(text) = &g.overrides {
+        let changed = crate::RunConfig::baseline_with(text).and_then(|with| {
+            crate::grid::differences(&crate::RunConfig::baseline_with("")?, &with)
+        });
+        let shown: Vec<String> = match changed {
+            Ok(differ) => differ
+                .iter()
+                .map(|(key, default, here)| format!("`{key} = {here}` (default {default})"))
+                .collect(),
+            Err(e) => vec![format!("unreadable: {e:#}")],
+        };
+        if !shown.is_empty() {
+            let _ = writeln!(md, "| settings changed from the defaults | {} |", shown.join("; "));
+        }
+    }
     if let Some(rescoring) = &g.rescoring {
         let settings: Vec<String> = rescoring
             .lines()

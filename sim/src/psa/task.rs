@@ -39,17 +39,23 @@ impl Task {
     }
 
     /// Whether a run of this task reads `setting`, a dotted key of a run's
-    /// configuration (`problem.tasks.task2_spin`): each task reads only its
-    /// own `[problem.tasks]` settings (`taskN_...`, see [`TaskSettings`]),
-    /// so a run of task 1 is the same run whatever task 2's start; every
-    /// other setting is read by every task.
+    /// configuration (`problem.tasks.task2_spin`, `problem.task2.steps`):
+    /// each task reads only its own `[problem.tasks]` settings
+    /// (`taskN_...`, see [`TaskSettings`]) and its own `[problem.taskN]`
+    /// table, so a run of task 1 is the same run whatever task 2's start;
+    /// every other setting is read by every task. The one rule every
+    /// command (replicate, sweep, rescore, report, resume) judges by.
     pub fn reads_setting(self, setting: &str) -> bool {
-        match setting.strip_prefix("problem.tasks.") {
-            Some(name) => name
+        let own = |n: &str| n == self.number().to_string();
+        if let Some(name) = setting.strip_prefix("problem.tasks.") {
+            return name
                 .strip_prefix("task")
                 .and_then(|rest| rest.split('_').next())
-                .is_some_and(|n| n == self.number().to_string()),
-            None => true,
+                .is_some_and(own);
+        }
+        match setting.strip_prefix("problem.task").map(|rest| rest.split('.').next().unwrap_or("")) {
+            Some(n) if !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) => own(n),
+            _ => true,
         }
     }
 
