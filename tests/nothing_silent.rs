@@ -949,7 +949,10 @@ fn a_rescoring_setting_no_task_of_the_grid_reads_is_refused_naming_it() {
     let source = copy_of_grid(dir.path());
     for (toml, key) in [
         ("[problem.tasks]\ntask2_spin = 1.0\n", "problem.tasks.task2_spin"),
-        ("[problem.tasks]\ntask2_velocity = [0.1, 0.0]\n", "problem.tasks.task2_velocity"),
+        (
+            "[problem.tasks]\ntask2_velocity = [0.1, 0.0]\n",
+            "problem.tasks.task2_velocity",
+        ),
         ("[problem.task2]\nsteps = 100\n", "problem.task2.steps"),
     ] {
         let config = dir.path().join("rescore.toml");
@@ -1059,10 +1062,15 @@ fn a_huge_vary_list_is_refused_at_once() {
     let o = run_within(&args, Duration::from_secs(20)).expect("refused within 20 s");
     refused(&o, &["esp.stagnation", "at most 10000"]);
     // 10^12 variants of four lists of 1000 values: counted, not compared.
-    let lists: Vec<String> = ["esp.stagnation", "esp.burst_scale", "problem.steps", "esp.lesion_threshold"]
-        .iter()
-        .map(|k| list(k, 1000))
-        .collect();
+    let lists: Vec<String> = [
+        "esp.stagnation",
+        "esp.burst_scale",
+        "problem.steps",
+        "esp.lesion_threshold",
+    ]
+    .iter()
+    .map(|k| list(k, 1000))
+    .collect();
     let vary: Vec<&str> = lists.iter().map(String::as_str).collect();
     let o = run_within(&tiny_sweep(&out, "1", &vary), Duration::from_secs(20)).expect("refused within 20 s");
     refused(&o, &["1000000000000 variants"]);
@@ -1128,7 +1136,10 @@ fn a_network_file_without_provenance_says_so() {
     let champion = run_folder(&grid).join("champion.json");
     let mut json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&champion).unwrap()).unwrap();
     json.as_object_mut().unwrap().remove("provenance");
-    json["problem"]["sensors"].as_object_mut().unwrap().remove("heading_wrap");
+    json["problem"]["sensors"]
+        .as_object_mut()
+        .unwrap()
+        .remove("heading_wrap");
     let file = dir.path().join("bare.json");
     std::fs::write(&file, json.to_string()).unwrap();
     refused(
@@ -1143,7 +1154,16 @@ fn evolve_refuses_a_folder_name_that_is_not_utf8() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join(std::ffi::OsStr::from_bytes(b"run-\xff"));
     let o = Command::new(common::binary())
-        .args(["evolve", "--task", "1", "--generations", "2", "--backend", "native", "--out"])
+        .args([
+            "evolve",
+            "--task",
+            "1",
+            "--generations",
+            "2",
+            "--backend",
+            "native",
+            "--out",
+        ])
         .arg(&out)
         .output()
         .unwrap();

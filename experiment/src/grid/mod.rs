@@ -521,8 +521,12 @@ pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
     let summary = RunFiles::in_dir(folder).summary;
     if summary.exists() {
         let json = psa_sim::io::read_input(&summary, "run summary")?;
-        serde_json::from_str::<serde_json::Value>(&json)
-            .with_context(|| format!("{}: damaged file, so the build that wrote the run is unknown", summary.display()))?;
+        serde_json::from_str::<serde_json::Value>(&json).with_context(|| {
+            format!(
+                "{}: damaged file, so the build that wrote the run is unknown",
+                summary.display()
+            )
+        })?;
     }
     let damaged = || format!("{}: damaged configuration", path.display());
     let table: toml::Table = toml::from_str(&text).with_context(damaged)?;

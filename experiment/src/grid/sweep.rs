@@ -121,8 +121,7 @@ pub fn parse_vary(text: &str) -> Result<Vary> {
     // mode): counted before any value is parsed.
     if parts.len() > MAX_VARIANTS {
         bail!(
-            "--vary {key}: {} values make {} variants or more; at most {MAX_VARIANTS} are allowed",
-            parts.len(),
+            "--vary {key}: {} values make as many variants; at most {MAX_VARIANTS} are allowed",
             parts.len()
         );
     }
@@ -420,7 +419,7 @@ fn variant_name(index: usize, width: usize, settings: &[(String, String)]) -> St
 }
 
 /// What a grid runs, in one string: its definition but the overrides,
-/// and the whole configuration of each of its configurations.
+/// and, for each configuration and task, the settings that task reads.
 fn grid_identity(grid: &GridSpec) -> Result<String> {
     let mut identity = serde_json::to_string(&GridSpec {
         overrides: None,

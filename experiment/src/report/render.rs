@@ -164,9 +164,8 @@ fn grid_section(md: &mut String, report: &Report) {
     // Every setting the grid's own overrides (`--config`) change from the
     // defaults, so that report.md alone tells two such grids apart.
     if let Some(text) = &g.overrides {
-        let changed = crate::RunConfig::baseline_with(text).and_then(|with| {
-            crate::grid::differences(&crate::RunConfig::baseline_with("")?, &with)
-        });
+        let changed = crate::RunConfig::baseline_with(text)
+            .and_then(|with| crate::grid::differences(&crate::RunConfig::baseline_with("")?, &with));
         let shown: Vec<String> = match changed {
             Ok(differ) => differ
                 .iter()

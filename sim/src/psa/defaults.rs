@@ -158,9 +158,7 @@ impl Placement {
     /// A file without one says so: its provenance is missing.
     pub fn of_json(provenance: Option<&serde_json::Map<String, Value>>) -> Placement {
         if provenance.is_none() {
-            return Placement::Unknown(
-                "the file has no \"provenance\", which names the build that wrote it".into(),
-            );
+            return Placement::Unknown("the file has no \"provenance\", which names the build that wrote it".into());
         }
         let defaults = provenance.and_then(|p| p.get("defaults")).and_then(Value::as_u64);
         let commit = provenance.and_then(|p| p.get("git_commit")).and_then(Value::as_str);

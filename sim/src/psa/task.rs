@@ -53,7 +53,10 @@ impl Task {
                 .and_then(|rest| rest.split('_').next())
                 .is_some_and(own);
         }
-        match setting.strip_prefix("problem.task").map(|rest| rest.split('.').next().unwrap_or("")) {
+        match setting
+            .strip_prefix("problem.task")
+            .map(|rest| rest.split('.').next().unwrap_or(""))
+        {
             Some(n) if !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) => own(n),
             _ => true,
         }
