@@ -178,7 +178,7 @@ fn bench_speedup_floor_exits_0_at_or_above_the_floor_and_1_below_it() {
             "--speedup-floor",
             floor,
             "--networks",
-            "16",
+            "32",
             "--rounds",
             "3",
             "--json",

@@ -792,17 +792,19 @@ fn a_run_resumed_without_lockstep_leaves_no_checkpoint() {
 
 // 9. Sweeps are checked whole before the first run.
 
-/// Eight keys of two values each: 256 variants, whose names would pass a
-/// file name's 255 bytes if each named every key and value in full.
+/// Eight keys of two values each, each read by task 1 (a key only tasks 2
+/// and 3 read would be refused in a task-1 grid): 256 variants, whose
+/// names would pass a file name's 255 bytes if each named every key and
+/// value in full.
 const VARIED: [&str; 8] = [
-    "problem.tasks.task3_random_distance=[0.25,0.55],[0.3,0.5]",
-    "problem.tasks.task2_velocity=[0.0,0.0],[0.1,0.0]",
+    "problem.noise.output_sd=0.0,0.05",
+    "problem.noise.input_sd=0.0,0.05",
     "problem.sensors.angular_velocity_scale=1.0,2.0",
     "problem.sensors.position_scale=10.0,20.0",
     "problem.fitness.heading_window=0.05,0.1",
     "problem.fitness.box_half_width=0.05,0.1",
-    "problem.tasks.task3_target_heading=0.0,0.5",
-    "problem.tasks.task2_target_heading=1.5707963267948966,1.0",
+    "problem.fitness.spin_window=0.05,0.1",
+    "problem.tasks.task1_spin=1.0,0.7853981633974483",
 ];
 
 #[test]
