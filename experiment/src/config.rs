@@ -16,7 +16,8 @@ use psa_sim::psa::PsaSettings;
 pub enum Algorithm {
     /// Enforced Sub-Populations.
     Esp,
-    /// The hill-climber.
+    /// The hill-climber (also read as "hill-climb", its preset's name).
+    #[serde(alias = "hill-climb")]
     HillClimb,
 }
 

@@ -200,12 +200,21 @@ impl NetworkFile {
     /// Reads and checks a file: JSON, format, version, activation, sizes,
     /// finite weights. Returns the file and its network.
     pub fn load(path: &Path) -> Result<(NetworkFile, Network), NetworkFileError> {
-        let fail = |problem: String| NetworkFileError {
+        let text = crate::io::read_input_text(path).map_err(|e| NetworkFileError {
             path: path.to_path_buf(),
+            problem: format!("cannot read it: {e}"),
+        })?;
+        NetworkFile::parse(&text, path)
+    }
+
+    /// Checks the text of a file as [`load`](Self::load) does; errors
+    /// name `origin`, where the text came from.
+    pub fn parse(text: &str, origin: &Path) -> Result<(NetworkFile, Network), NetworkFileError> {
+        let fail = |problem: String| NetworkFileError {
+            path: origin.to_path_buf(),
             problem,
         };
-        let text = crate::io::read_input_text(path).map_err(|e| fail(format!("cannot read it: {e}")))?;
-        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| fail(format!("not valid JSON: {e}")))?;
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| fail(format!("not valid JSON: {e}")))?;
         match value.get("format").and_then(|f| f.as_str()) {
             Some(FORMAT) => {}
             Some(other) => return Err(fail(format!("format is {other:?}, expected {FORMAT:?}"))),
