@@ -22,7 +22,9 @@ pub const DEFAULT_BACKEND: BackendKind = BackendKind::Native;
 /// dict of settings or the path of a TOML file, as `--config` takes) laid
 /// over it, then `backend` if given.
 pub fn run_config(config: Option<&Bound<'_, PyAny>>, preset: &str, backend: Option<&str>) -> PyResult<RunConfig> {
-    let preset: Preset = preset.parse().map_err(errors::config)?;
+    // Presets are named with hyphens ("hill-climb"); the underscores of
+    // the algorithms' names ("hill_climb") are taken as well.
+    let preset: Preset = preset.replace('_', "-").parse().map_err(errors::config)?;
     let mut base = preset.config();
     base.problem.backend = DEFAULT_BACKEND;
     let mut resolved = overlay(base, config)?;
