@@ -21,7 +21,7 @@ def test_the_extension_carries_its_libode():
     linked = subprocess.run(["ldd", str(extension)], capture_output=True, text=True, check=True).stdout
     ode = [line for line in linked.splitlines() if "libode" in line]
     assert ode, linked
-    bundled = extension.parents[1] / "psa_esp.libs"
+    bundled = (extension.parents[1] / "psa_esp.libs").resolve()
     for line in ode:
-        path = Path(line.split("=>")[1].split("(")[0].strip())
+        path = Path(line.split("=>")[1].split("(")[0].strip()).resolve()
         assert path.parent == bundled, f"libode comes from outside the wheel: {line}"
