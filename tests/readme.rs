@@ -1,6 +1,7 @@
 //! The README against the program and the repository: each command's
 //! synopsis under "Commands" names exactly the options of that command's
-//! own `--help`, and every relative link in the project's Markdown
+//! own `--help` (and, where both list an option's values, the same values),
+//! and every relative link in the project's Markdown
 //! (README.md, CHANGELOG.md, CONTRIBUTING.md, docs/) reaches a file and,
 //! where it names one, a heading of it.
 
@@ -23,7 +24,7 @@ fn help(args: &[&str]) -> String {
     String::from_utf8(out.stdout).expect("help is UTF-8")
 }
 
-/// The `--long` names in a piece of text, in order of first appearance.
+/// The `--long` names in a piece of text.
 fn long_options(text: &str) -> BTreeSet<String> {
     let mut names = BTreeSet::new();
     let mut rest = text;
@@ -55,6 +56,46 @@ fn help_options(help: &str) -> BTreeSet<String> {
         .flat_map(|line| long_options(line.split("  ").find(|s| s.contains("--")).unwrap_or("")))
         .filter(|name| name != "--help")
         .collect()
+}
+
+/// The values each option of a `--help` allows, where clap lists them:
+/// `[possible values: a, b]`, or a `Possible values:` list of `- a: ...`.
+fn help_values(help: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let options = help.split_once("\nOptions:\n").map(|(_, o)| o).unwrap_or_default();
+    let mut values = BTreeMap::<String, BTreeSet<String>>::new();
+    let mut current = String::new();
+    for line in options.lines() {
+        let trimmed = line.trim_start();
+        let indent = line.len() - trimmed.len();
+        if (2..=6).contains(&indent) && trimmed.starts_with('-') {
+            current = long_options(line.split("  ").find(|s| s.contains("--")).unwrap_or(""))
+                .pop_first()
+                .unwrap_or_default();
+        }
+        if let Some((_, listed)) = line.split_once("[possible values: ") {
+            let listed = listed.split(']').next().unwrap_or("");
+            let set = values.entry(current.clone()).or_default();
+            set.extend(listed.split(", ").map(str::to_owned));
+        } else if let Some(item) = trimmed.strip_prefix("- ").filter(|_| indent > 6) {
+            let value = item.split(':').next().unwrap_or("").to_owned();
+            values.entry(current.clone()).or_default().insert(value);
+        }
+    }
+    values
+}
+
+/// The values a synopsis lists for an option, as in `--preset quick|paper`.
+fn synopsis_values(synopsis: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let words: Vec<&str> = synopsis.split_whitespace().collect();
+    let mut values = BTreeMap::new();
+    for pair in words.windows(2) {
+        let option = pair[0].trim_start_matches('[');
+        let listed = pair[1].trim_end_matches(']');
+        if option.starts_with("--") && !option.contains('|') && listed.contains('|') && !listed.starts_with('-') {
+            values.insert(option.to_owned(), listed.split('|').map(str::to_owned).collect());
+        }
+    }
+    values
 }
 
 /// The subcommands `psa-esp --help` lists (without clap's `help`).
@@ -139,8 +180,18 @@ fn each_readme_synopsis_names_exactly_the_options_of_its_commands_help() {
     let mut problems = Vec::new();
     for name in synopses.keys() {
         let args: Vec<&str> = if name.is_empty() { vec![] } else { vec![name.as_str()] };
-        let in_help = help_options(&help(&args));
+        let text = help(&args);
+        let in_help = help_options(&text);
         let in_readme = synopsis_options(&synopses, name);
+        let allowed = help_values(&text);
+        for (option, listed) in synopsis_values(&synopses[name]) {
+            match allowed.get(&option) {
+                Some(values) if *values != listed => problems.push(format!(
+                    "psa-esp {name} {option}: the README lists {listed:?}, --help {values:?}"
+                )),
+                _ => {}
+            }
+        }
         let missing: Vec<_> = in_help.difference(&in_readme).collect();
         let extra: Vec<_> = in_readme.difference(&in_help).collect();
         if !missing.is_empty() || !extra.is_empty() {
@@ -194,31 +245,29 @@ fn anchor(heading: &str) -> String {
         .collect()
 }
 
-fn anchors(markdown: &str) -> BTreeSet<String> {
+/// The lines of a Markdown text outside its fenced code blocks.
+fn outside_code(markdown: &str) -> impl Iterator<Item = &str> {
     let mut in_code = false;
-    let mut found = BTreeSet::new();
-    for line in markdown.lines() {
+    markdown.lines().filter(move |line| {
         if line.starts_with("```") {
             in_code = !in_code;
-        } else if !in_code && line.starts_with('#') {
-            found.insert(anchor(line.trim_start_matches('#')));
+            return false;
         }
-    }
-    found
+        !in_code
+    })
+}
+
+fn anchors(markdown: &str) -> BTreeSet<String> {
+    outside_code(markdown)
+        .filter(|line| line.starts_with('#'))
+        .map(|line| anchor(line.trim_start_matches('#')))
+        .collect()
 }
 
 /// The relative targets of `](target)` links outside code blocks.
 fn relative_links(markdown: &str) -> Vec<String> {
-    let mut in_code = false;
     let mut links = Vec::new();
-    for line in markdown.lines() {
-        if line.starts_with("```") {
-            in_code = !in_code;
-            continue;
-        }
-        if in_code {
-            continue;
-        }
+    for line in outside_code(markdown) {
         let mut rest = line;
         while let Some(at) = rest.find("](") {
             let after = &rest[at + 2..];
