@@ -3,7 +3,8 @@
 //! own `--help` (and, where both list an option's values, the same values),
 //! and every relative link in the project's Markdown
 //! (README.md, CHANGELOG.md, CONTRIBUTING.md, docs/) reaches a file and,
-//! where it names one, a heading of it.
+//! where it names one, a heading of it; every `docs/*.md` a source,
+//! manifest or script cites exists.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -306,4 +307,55 @@ fn every_relative_link_in_the_markdown_reaches_its_file_and_heading() {
         }
     }
     assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
+
+/// Every file of the repository whose text may cite a doc: sources,
+/// manifests, configuration files and scripts (not `target/` or hidden
+/// folders).
+fn citing_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    let mut dirs = vec![root().to_path_buf()];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).expect("read a folder") {
+            let path = entry.expect("a folder entry").path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if path.is_dir() {
+                if !name.starts_with('.') && name != "target" {
+                    dirs.push(path);
+                }
+            } else if ["rs", "toml", "py", "sh", "cff"]
+                .iter()
+                .any(|e| path.extension().is_some_and(|x| x == *e))
+            {
+                files.push(path);
+            }
+        }
+    }
+    files
+}
+
+#[test]
+fn every_doc_a_source_file_cites_exists() {
+    let mut missing = Vec::new();
+    for file in citing_files() {
+        let Ok(text) = std::fs::read_to_string(&file) else {
+            continue;
+        };
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find("docs/") {
+            let after = &rest[at..];
+            let len = after
+                .find(|c: char| !(c.is_ascii_alphanumeric() || "_-./".contains(c)))
+                .unwrap_or(after.len());
+            let cited = after[..len].trim_end_matches('.');
+            // A path that only ends in docs/ (another folder's) is not the repository's.
+            let inside_a_path = rest[..at].ends_with(|c: char| c == '/' || c.is_ascii_alphanumeric());
+            if cited.ends_with(".md") && !inside_a_path && !root().join(cited).exists() {
+                let shown = file.strip_prefix(root()).unwrap_or(&file).display().to_string();
+                missing.push(format!("{shown}: {cited}"));
+            }
+            rest = &after[len.max(5)..];
+        }
+    }
+    assert!(missing.is_empty(), "docs cited but missing:\n{}", missing.join("\n"));
 }
