@@ -37,7 +37,7 @@ pub fn build_info() -> psa_sim::provenance::BuildInfo {
         tool_version: env!("CARGO_PKG_VERSION").into(),
         git_commit: env!("PSA_ESP_GIT_COMMIT").into(),
         libode_version: psa_sim::ode::libode_version().into(),
-        defaults: Some(psa_sim::psa::defaults::rows() as u64),
+        defaults: Some(psa_sim::psa::settings::defaults::rows() as u64),
     }
 }
 

@@ -9,7 +9,7 @@ use esp_neuroevolution::rng::stream;
 use numpy::{PyArray1, PyArray2};
 use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::RunConfig;
-use psa_sim::psa::limits::{check_as, MAX_TRIALS};
+use psa_sim::psa::settings::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;

@@ -8,8 +8,8 @@
 use anyhow::{bail, Result};
 use serde::Serialize;
 
-use super::bench::{evaluation_rate, EvaluationPath};
 use super::bench_networks::random_networks;
+use super::bench_paths::{evaluation_rate, EvaluationPath};
 use super::bench_runs::median;
 use super::EXIT_CHECK_FAILED;
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};

@@ -4,7 +4,7 @@ use anyhow::Result;
 
 use super::{PhysicsArgs, EXIT_CHECK_FAILED};
 use psa_sim::physics::crosscheck;
-use psa_sim::psa::limits::MAX_STEPS;
+use psa_sim::psa::settings::limits::MAX_STEPS;
 use psa_sim::psa::BodySettings;
 
 /// The most random thrust sequences of one cross-check (only time grows with them).

@@ -9,7 +9,7 @@ use super::choice::choice;
 use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::plots::{write_trial_pictures, TrialPicture};
 use psa_sim::physics::BackendKind;
-use psa_sim::psa::limits::{check_as, MAX_TRIALS};
+use psa_sim::psa::settings::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
 
 /// Key of the random stream of replays.

@@ -20,7 +20,7 @@ use psa_experiment::GridConfig;
 use psa_sim::evaluator::EvalPath;
 use psa_sim::ode::MAX_THREADS;
 use psa_sim::physics::BackendKind;
-use psa_sim::psa::limits::MAX_TRIALS;
+use psa_sim::psa::settings::limits::MAX_TRIALS;
 use psa_sim::psa::Task;
 
 /// Arguments of `replicate`.

@@ -8,7 +8,8 @@ use anyhow::{bail, Result};
 use super::choice::choice;
 use super::{PhysicsArgs, TRAJECTORY_HEADER};
 use psa_sim::physics::{create_backend, for_each_state, BackendKind, BodyState, PhysicsBackend};
-use psa_sim::psa::{limits, BodySettings, THRUSTER_COUNT};
+use psa_sim::psa::settings::limits;
+use psa_sim::psa::{BodySettings, THRUSTER_COUNT};
 
 /// Arguments of `simulate`.
 #[derive(Debug, clap::Args)]

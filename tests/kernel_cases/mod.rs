@@ -7,7 +7,7 @@ use esp_neuroevolution::rng::{stream, Stream};
 use psa_sim::numeric::Exponential;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::cuda::{evaluate_with, TrialBatch, TrialPoints};
-use psa_sim::psa::readings::every_test_value;
+use psa_sim::psa::settings::readings::every_test_value;
 use psa_sim::psa::{FitnessKind, NoiseSettings, PsaError, PsaSettings, Task, TrialRunner};
 use rand::RngExt;
 
@@ -58,7 +58,7 @@ pub fn original_fitness_settings() -> PsaSettings {
 
 /// Every reading of the inputs and the fitness at a value other than its
 /// default, together: the test value of each row of
-/// [`READINGS`](psa_sim::psa::readings::READINGS) (with the table's rows
+/// [`READINGS`](psa_sim::psa::settings::readings::READINGS) (with the table's rows
 /// today: the heading input absolute and wrapped to (-pi, pi], the signed
 /// slowing rule, the fitness read from the true state, task 3 evolved on
 /// the original fitness over 250 steps, task 1 scored on the incremental

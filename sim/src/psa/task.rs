@@ -157,11 +157,11 @@ impl Default for TaskSettings {
 }
 
 impl TaskSettings {
-    /// Rejects values outside their [ranges](super::limits) and an empty
+    /// Rejects values outside their [ranges](super::settings::limits) and an empty
     /// distance range.
     pub fn validate(&self) -> Result<(), String> {
         let [lo, hi] = self.task3_random_distance;
-        super::limits::check_all(&[
+        super::settings::limits::check_all(&[
             ("tasks.task1_spin", self.task1_spin),
             ("tasks.task2_target_heading", self.task2_target_heading),
             ("tasks.task2_spin", self.task2_spin),

@@ -227,7 +227,7 @@ pub fn check_as(key: &str, shown: &str, value: f64) -> Result<(), String> {
     match limit(key) {
         Some(l) => l.check_as(shown, value),
         None => Err(format!(
-            "{shown}: no range is defined for key {key:?} (a bug: add it to psa::limits::LIMITS)"
+            "{shown}: no range is defined for key {key:?} (a bug: add it to psa::settings::limits::LIMITS)"
         )),
     }
 }
@@ -252,7 +252,7 @@ mod tests {
 
     #[test]
     fn the_documentation_lists_every_key() {
-        let doc = include_str!("../../../docs/limits.md");
+        let doc = include_str!("../../../../docs/limits.md");
         for l in LIMITS {
             assert!(doc.contains(&format!("`{}`", l.key)), "docs/limits.md lacks {}", l.key);
         }
