@@ -23,7 +23,8 @@ pub mod results;
 mod run;
 
 pub use config::{
-    paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, BASELINE, PAPER_NOISE_SD, PAPER_NOISY_TRIALS,
+    paper_esp_settings, Algorithm, GridConfig, GridConfigKind, Preset, RunConfig, BASELINE, PAPER_NOISE_SD,
+    PAPER_NOISY_TRIALS,
 };
 pub use report::{write_report, ReportFormat, ReportOutcome};
 pub use results::EvolveOutcome;

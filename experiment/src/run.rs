@@ -1,5 +1,6 @@
 //! One evolution run, written to its own directory.
 
+use psa_sim::named::Named;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -1,6 +1,7 @@
 //! Network files in the CLI's format (docs/file-formats.md, "Network
 //! files"), and `replay`, which flies one as `psa-esp replay` does.
 
+use psa_sim::named::Named;
 use std::path::PathBuf;
 
 use esp_neuroevolution::math::Exponential;

@@ -2,6 +2,7 @@
 //! NumPy arrays with the crate's tickets, by the PSA natively, or by a
 //! Python fitness function; saved and resumed through the crate's serde.
 
+use psa_sim::named::Named;
 use std::path::PathBuf;
 
 use esp_neuroevolution::network::{Network, NetworkSet};

@@ -8,6 +8,7 @@
 //! its arithmetic), and the 2-thread speed-up and algorithm overhead of
 //! `evolve` and `replicate` (see [`super::bench_runs`]).
 
+use psa_sim::named::Named;
 use std::time::Instant;
 
 use anyhow::Result;
@@ -18,6 +19,7 @@ use super::bench_kernel::{kernel_rows, KernelBench, KERNEL_NETWORKS};
 use super::bench_networks::{random_networks, HIDDEN};
 use super::bench_paths::{evaluation_rate, EvaluationPath};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
+use super::choice::choice;
 use esp_neuroevolution::network::Network;
 use psa_sim::evaluator::EvalPath;
 use psa_sim::numeric::{sigmoid, Lanes, SimdLevel};
@@ -65,15 +67,8 @@ pub struct BenchArgs {
           conflicts_with_all = ["steps", "generations", "kernel_networks", "kernel_host", "kernel_only"])]
     pub speedup_floor: Option<f64>,
     /// The SIMD level --speedup-floor times (default: the CPU's best).
-    #[arg(long, requires = "speedup_floor", value_parser = simd_level_parser())]
+    #[arg(long, requires = "speedup_floor", value_parser = choice::<SimdLevel>())]
     pub speedup_level: Option<SimdLevel>,
-}
-
-/// The parser of `--speedup-level`: one of [`SimdLevel::ALL`]'s names.
-fn simd_level_parser() -> impl clap::builder::TypedValueParser<Value = SimdLevel> {
-    use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(SimdLevel::ALL.map(SimdLevel::name))
-        .map(|name| name.parse().expect("clap admits only the names"))
 }
 
 /// One path's speed at whole network evaluations (one 500-step trial each).

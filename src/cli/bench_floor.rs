@@ -6,6 +6,7 @@
 //! AVX-512 paths clear with room: CI runs it (`.ci/run`).
 
 use anyhow::{bail, Result};
+use psa_sim::named::Named;
 use serde::Serialize;
 
 use super::bench_networks::random_networks;

@@ -7,11 +7,12 @@ use std::time::Instant;
 
 use anyhow::Result;
 use serde::Serialize;
+use strum::VariantArray;
 
 use esp_neuroevolution::evaluate_all;
 use esp_neuroevolution::network::Network;
 use psa_experiment::PAPER_NOISE_SD;
-use psa_sim::evaluator::{EvalPath, PsaEvaluator};
+use psa_sim::evaluator::{EvalPath, EvalPathKind, PsaEvaluator};
 use psa_sim::numeric::SimdLevel;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::{PsaSettings, Task};
@@ -36,14 +37,26 @@ pub struct EvaluationPath {
 impl Serialize for EvaluationPath {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
+        // Every path by name, with no `_`: a new one is a compile error
+        // here until it is written apart from the others.
         let simd = match self.path {
             EvalPath::Simd(level) => Some(level),
-            _ => None,
+            EvalPath::Fastest
+            | EvalPath::Scalar
+            | EvalPath::OdeLockstep
+            | EvalPath::KernelOnHost
+            | EvalPath::Kernel(_) => None,
+        };
+        let ode_lockstep = match self.path {
+            EvalPath::OdeLockstep => true,
+            EvalPath::Fastest | EvalPath::Scalar | EvalPath::Simd(_) | EvalPath::KernelOnHost | EvalPath::Kernel(_) => {
+                false
+            }
         };
         let mut row = serializer.serialize_struct("EvaluationPath", 4)?;
         row.serialize_field("backend", &self.backend)?;
         row.serialize_field("simd", &simd)?;
-        row.serialize_field("ode_lockstep", &matches!(self.path, EvalPath::OdeLockstep))?;
+        row.serialize_field("ode_lockstep", &ode_lockstep)?;
         row.serialize_field("input_noise", &self.input_noise)?;
         row.end()
     }
@@ -52,12 +65,18 @@ impl Serialize for EvaluationPath {
 impl EvaluationPath {
     /// The path's name in the bench's table.
     pub fn label(&self) -> String {
-        let path = match (self.backend, &self.path) {
-            (BackendKind::Native, EvalPath::Simd(level)) => format!("native batched {level}"),
-            (BackendKind::Ode, EvalPath::OdeLockstep) => "ode lockstep".into(),
-            (BackendKind::Native, _) => "native scalar".into(),
-            (BackendKind::Ode, _) => "ode one world each".into(),
-            (backend, _) => backend.name().into(),
+        let backend = self.backend;
+        let path = match &self.path {
+            EvalPath::Scalar => match backend {
+                BackendKind::Native => "native scalar".into(),
+                BackendKind::Ode => "ode one world each".into(),
+                BackendKind::Rapier => "rapier".into(),
+            },
+            EvalPath::Simd(level) => format!("{backend} batched {level}"),
+            EvalPath::OdeLockstep => format!("{backend} lockstep"),
+            EvalPath::Fastest => format!("{backend} fastest"),
+            EvalPath::KernelOnHost => format!("{backend} kernel-host"),
+            EvalPath::Kernel(_) => format!("{backend} kernel"),
         };
         if self.input_noise {
             format!("{path}, input noise")
@@ -77,16 +96,27 @@ impl EvaluationPath {
         };
         let mut paths = Vec::new();
         for backend in BackendKind::available() {
-            paths.push(on(backend, EvalPath::Scalar));
-            match backend {
-                BackendKind::Ode => paths.push(on(backend, EvalPath::OdeLockstep)),
-                BackendKind::Native => paths.extend(
-                    SimdLevel::ALL
-                        .into_iter()
-                        .filter(|l| l.is_supported())
-                        .map(|level| on(backend, EvalPath::Simd(level))),
-                ),
-                BackendKind::Rapier => {}
+            // Every kind of path by name: a new one is a compile error here
+            // until the bench times it or says why not.
+            for kind in EvalPathKind::VARIANTS {
+                match kind {
+                    // One of the paths below, picked at run time.
+                    EvalPathKind::Fastest => {}
+                    EvalPathKind::Scalar => paths.push(on(backend, EvalPath::Scalar)),
+                    EvalPathKind::Simd if backend == BackendKind::Native => paths.extend(
+                        SimdLevel::VARIANTS
+                            .iter()
+                            .filter(|l| l.is_supported())
+                            .map(|&level| on(backend, EvalPath::Simd(level))),
+                    ),
+                    EvalPathKind::OdeLockstep if backend == BackendKind::Ode => {
+                        paths.push(on(backend, EvalPath::OdeLockstep))
+                    }
+                    // Only native is batched and only ode in lockstep.
+                    EvalPathKind::Simd | EvalPathKind::OdeLockstep => {}
+                    // Timed by the kernel's rows (`bench_kernel`).
+                    EvalPathKind::KernelOnHost | EvalPathKind::Kernel => {}
+                }
             }
         }
         let native = |p: &&EvaluationPath| p.backend == BackendKind::Native;

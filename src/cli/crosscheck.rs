@@ -1,6 +1,7 @@
 //! `psa-esp crosscheck`: every backend against ODE on random thrust sequences.
 
 use anyhow::Result;
+use psa_sim::named::Named;
 
 use super::{PhysicsArgs, EXIT_CHECK_FAILED};
 use psa_sim::physics::crosscheck;

@@ -1,5 +1,6 @@
 //! `psa-esp evolve`: one evolution run of a preset on a task.
 
+use psa_sim::named::Named;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -18,7 +19,7 @@ pub struct EvolveArgs {
     #[arg(long)]
     pub task: Task,
     /// The paper's configuration to start from.
-    #[arg(long, value_parser = choice(&Preset::ALL, Preset::name), default_value_t = Preset::Baseline)]
+    #[arg(long, value_parser = choice::<Preset>(), default_value_t = Preset::Baseline)]
     pub preset: Preset,
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]

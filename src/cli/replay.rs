@@ -24,7 +24,7 @@ pub struct ReplayArgs {
     #[arg(long)]
     pub task: Option<Task>,
     /// Physics backend.
-    #[arg(long, value_parser = choice(&BackendKind::ALL, BackendKind::name), default_value_t = BackendKind::Ode)]
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Standard deviation of Gaussian noise on every input but the bias.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]

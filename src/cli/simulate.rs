@@ -15,7 +15,7 @@ use psa_sim::psa::{BodySettings, THRUSTER_COUNT};
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
     /// Physics backend.
-    #[arg(long, value_parser = choice(&BackendKind::ALL, BackendKind::name), default_value_t = BackendKind::Ode)]
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Constant thrust of the four thrusters, each in [0, 1]: u0,u1,u2,u3.
     #[arg(

@@ -26,7 +26,9 @@ pub mod runner;
 pub mod shard;
 pub mod sweep;
 
+use psa_sim::named::Named;
 use std::path::{Path, PathBuf};
+use strum::VariantArray;
 
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
@@ -52,8 +54,21 @@ pub const GRID_KEYS: [(&str, &str); 3] = [
 pub const MAX_SEEDS: u64 = 10_000;
 
 /// Which protocol a grid follows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum GridPreset {
     /// A reduced grid that finishes in about a minute on 2 cores.
     Quick,
@@ -62,17 +77,8 @@ pub enum GridPreset {
     Paper,
 }
 
-impl GridPreset {
-    /// Every preset.
-    pub const ALL: [GridPreset; 2] = [GridPreset::Quick, GridPreset::Paper];
-
-    /// The preset's name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            GridPreset::Quick => "quick",
-            GridPreset::Paper => "paper",
-        }
-    }
+impl Named for GridPreset {
+    const WHAT: &'static str = "grid preset";
 }
 
 /// A grid's definition, written to `grid.json`.
@@ -148,8 +154,8 @@ impl GridSpec {
             format: GRID_FORMAT.into(),
             version: GRID_VERSION,
             preset,
-            configs: GridConfig::ALL.into_iter().filter(|c| c.in_paper()).collect(),
-            tasks: Task::ALL.into_iter().filter(|t| t.in_paper()).collect(),
+            configs: GridConfig::all().into_iter().filter(|c| c.in_paper()).collect(),
+            tasks: Task::VARIANTS.iter().copied().filter(|t| t.in_paper()).collect(),
             seeds,
             generations,
             backend,

@@ -1,6 +1,7 @@
 //! The paper's findings and the explicit rules that judge each one, here
 //! and (as a check of the rules) on the paper's own numbers.
 
+use psa_sim::named::Named;
 use serde::Serialize;
 
 use super::paper::{

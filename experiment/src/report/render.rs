@@ -1,5 +1,6 @@
 //! The report as Markdown and as CSV.
 
+use psa_sim::named::Named;
 use std::fmt::Write as _;
 
 use super::distance::Distance;

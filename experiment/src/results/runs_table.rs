@@ -3,6 +3,7 @@
 //! must not round them reads the column as integers or text, e.g. pandas'
 //! `dtype={"run_seed": "uint64"}`).
 
+use psa_sim::named::Named;
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -8,6 +8,7 @@ pub mod limits;
 pub mod readings;
 
 use serde::{Deserialize, Serialize};
+use strum::VariantArray;
 
 use super::error::PsaError;
 use super::fitness::{FitnessKind, FitnessSettings, Scoring};
@@ -120,7 +121,7 @@ impl PsaSettings {
             ),
         ])
         .map_err(PsaError::Setting)?;
-        for task in Task::ALL {
+        for &task in Task::VARIANTS {
             if let Some(steps) = self.overrides(task).steps {
                 limits::check_as("steps", &format!("task{task}.steps"), steps as f64).map_err(PsaError::Setting)?;
             }
