@@ -19,7 +19,6 @@ mod tables;
 #[cfg(test)]
 mod tests;
 
-use psa_sim::named::Named;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -29,6 +28,7 @@ use crate::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
 use crate::results::runs_table::{runs_csv, RUNS_CSV};
 use crate::results::{load_run, GenerationRow, RunData};
 use crate::GridConfig;
+use psa_sim::named::Named;
 use psa_sim::psa::Task;
 
 pub use distance::{Distance, Part, Term};

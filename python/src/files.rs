@@ -1,7 +1,6 @@
 //! Network files in the CLI's format (docs/file-formats.md, "Network
 //! files"), and `replay`, which flies one as `psa-esp replay` does.
 
-use psa_sim::named::Named;
 use std::path::PathBuf;
 
 use esp_neuroevolution::math::Exponential;
@@ -10,6 +9,7 @@ use esp_neuroevolution::rng::stream;
 use numpy::{PyArray1, PyArray2};
 use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::RunConfig;
+use psa_sim::named::Named;
 use psa_sim::psa::settings::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyTypeError, PyValueError};

@@ -2,7 +2,6 @@
 //! NumPy arrays with the crate's tickets, by the PSA natively, or by a
 //! Python fitness function; saved and resumed through the crate's serde.
 
-use psa_sim::named::Named;
 use std::path::PathBuf;
 
 use esp_neuroevolution::network::{Network, NetworkSet};
@@ -10,6 +9,7 @@ use esp_neuroevolution::{AnyRun, AskPurpose, AskTell, Esp, GenerationRecord, Hil
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray};
 use psa_experiment::{Algorithm, RunConfig, RunStart};
 use psa_sim::evaluator::PsaEvaluator;
+use psa_sim::named::Named;
 use psa_sim::psa::NetworkFile;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;

@@ -8,7 +8,6 @@
 //! its arithmetic), and the 2-thread speed-up and algorithm overhead of
 //! `evolve` and `replicate` (see [`super::bench_runs`]).
 
-use psa_sim::named::Named;
 use std::time::Instant;
 
 use anyhow::Result;
@@ -22,6 +21,7 @@ use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_w
 use super::choice::choice;
 use esp_neuroevolution::network::Network;
 use psa_sim::evaluator::EvalPath;
+use psa_sim::named::Named;
 use psa_sim::numeric::{sigmoid, Lanes, SimdLevel};
 use psa_sim::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
 use psa_sim::psa::batch::LANES;

@@ -1,6 +1,5 @@
 //! `psa-esp evolve`: one evolution run of a preset on a task.
 
-use psa_sim::named::Named;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -9,6 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::backend::{BackendArg, EvalPathArg};
 use super::choice::choice;
 use psa_experiment::{run_evolution, Preset};
+use psa_sim::named::Named;
 use psa_sim::ode::MAX_THREADS;
 use psa_sim::psa::Task;
 

@@ -26,7 +26,6 @@ pub mod runner;
 pub mod shard;
 pub mod sweep;
 
-use psa_sim::named::Named;
 use std::path::{Path, PathBuf};
 use strum::VariantArray;
 
@@ -34,6 +33,7 @@ use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::{EvolveOutcome, GridConfig, RunConfig, RunFiles};
+use psa_sim::named::Named;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::Task;
 

@@ -11,10 +11,10 @@
 //! DIR/variants/<variant>/runs/...
 //! ```
 
-use psa_sim::named::Named;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use psa_sim::named::Named;
 use serde::{Deserialize, Serialize};
 
 use crate::grid::replicate::{replicate_grids, GridJob, GridProgress, HeldRun, ReplicateOptions};

@@ -17,7 +17,6 @@
 //!   1868 / 2448), its se that of a ratio of two counts, ratio x sqrt(1 /
 //!   2448 + 1 / 1868).
 
-use psa_sim::named::Named;
 use serde::Serialize;
 
 use super::paper::{paper_bursts, paper_cell, PAPER_BURST_RUNS, PAPER_RUNS_PER_TASK, PAPER_TASKS};
@@ -25,6 +24,7 @@ use super::{GridResults, Metric};
 use crate::results::stats::mean_sd;
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
+use psa_sim::named::Named;
 use psa_sim::psa::Task;
 
 /// Max credit, the paper's second burst total.

@@ -1,7 +1,6 @@
 //! The paper's findings and the explicit rules that judge each one, here
 //! and (as a check of the rules) on the paper's own numbers.
 
-use psa_sim::named::Named;
 use serde::Serialize;
 
 use super::paper::{
@@ -11,6 +10,7 @@ use super::{GridResults, Metric};
 use crate::results::stats::{mean_sd, welch};
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
+use psa_sim::named::Named;
 use psa_sim::psa::Task;
 
 /// Significance level of the Welch rules.

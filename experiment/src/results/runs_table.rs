@@ -3,11 +3,11 @@
 //! must not round them reads the column as integers or text, e.g. pandas'
 //! `dtype={"run_seed": "uint64"}`).
 
-use psa_sim::named::Named;
 use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use psa_sim::named::Named;
 
 use crate::grid::run_dir;
 use crate::results::columns::{csv_field, header, row, Column};
