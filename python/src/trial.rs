@@ -9,6 +9,7 @@ use std::f64::consts::{PI, TAU};
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
 use psa_experiment::plots::{trial_frame, TrialPicture, FIGURE_HEIGHT, FIGURE_WIDTH};
+use psa_sim::named::Named;
 use psa_sim::numeric::{clamp_unit, NoiseSource};
 use psa_sim::physics::{create_backend, BodyState, PhysicsBackend, PlanarState};
 use psa_sim::psa::step::{score, sense, Reading};
