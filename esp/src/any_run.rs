@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{AskTell, Asked, Ending, EspRun, GenerationRecord, HillClimbRun, RunError, RunResult, Ticket};
+use crate::{AskTell, Asked, Champion, Ending, EspRun, GenerationRecord, HillClimbRun, RunError, RunResult, Ticket};
 
 /// An ESP run or a hill-climbing run, driven by ask and tell like either,
 /// and saved and restored by serde like either (tagged with its kind).
@@ -83,5 +83,8 @@ impl AskTell for AnyRun {
     }
     fn result(&self) -> Result<RunResult, RunError> {
         self.inner().result()
+    }
+    fn champion(&self) -> Option<&Champion> {
+        self.inner().champion()
     }
 }

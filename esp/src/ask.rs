@@ -19,7 +19,7 @@ use crate::evaluator::{check_fitness, evaluate_all};
 use crate::network::{Network, NetworkSet};
 use crate::rng::StreamFamily;
 use crate::subpop::Assembled;
-use crate::{Ending, Evaluator, GenerationRecord, RunError, RunResult};
+use crate::{Champion, Ending, Evaluator, GenerationRecord, RunError, RunResult};
 
 /// What a batch of asked networks is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -53,7 +53,7 @@ pub struct Asked<'a> {
 /// run or of an ask told already, so that fitness is never applied to
 /// networks it was not computed for. A restored run (serde) issues new
 /// tickets: those of the run it was saved from are foreign to it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Ticket {
     run: u64,
     ask: u64,
@@ -238,6 +238,11 @@ pub trait AskTell {
 
     /// The result of the ended run (a copy); [`RunError::NotEnded`] before.
     fn result(&self) -> Result<RunResult, RunError>;
+
+    /// The best network found so far (the champion of the generations
+    /// completed so far), while the run goes on as after it has ended;
+    /// `None` before the first generation (cycle) is complete.
+    fn champion(&self) -> Option<&Champion>;
 }
 
 impl<T: AskTell + ?Sized> AskTell for Box<T> {
@@ -258,6 +263,9 @@ impl<T: AskTell + ?Sized> AskTell for Box<T> {
     }
     fn result(&self) -> Result<RunResult, RunError> {
         (**self).result()
+    }
+    fn champion(&self) -> Option<&Champion> {
+        (**self).champion()
     }
 }
 

@@ -311,6 +311,10 @@ impl<A: Search> AskTell for Driver<A> {
             ending,
         })
     }
+
+    fn champion(&self) -> Option<&Champion> {
+        A::champion(&self.saved.state)
+    }
 }
 
 /// Drives `run` to its end on the current rayon pool: ask, evaluate with
@@ -358,6 +362,9 @@ macro_rules! public_run {
             }
             fn result(&self) -> Result<$crate::RunResult, $crate::RunError> {
                 self.0.result()
+            }
+            fn champion(&self) -> Option<&$crate::Champion> {
+                self.0.champion()
             }
         }
 

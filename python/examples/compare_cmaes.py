@@ -19,7 +19,10 @@ stops before the budget is spent.
 Reported per run: the champion's evolution fitness (what the search
 maximised) and its score on Sit's original fitness, flown once from the
 standard start (the paper's Table 1, as the replication's report
-measures it).
+measures it). Each run's file records what made it: the package's build,
+the model's settings (the baseline configuration, resolved) and the
+versions of pycma and NumPy; `--report` refuses files of another model
+(made by a build whose defaults differ: run them again).
 """
 
 from __future__ import annotations
@@ -50,6 +53,28 @@ TASKS = (1, 2, 3)
 SCORING = {"problem": {"fitness": {"kind": "original"}}}
 #: The champion's fitness after every CURVE_STEP evaluations, for the figure.
 CURVE_STEP = 8000
+
+
+def model():
+    """The model's settings the runs are made on: the baseline
+    configuration on the package's default backend, as TOML."""
+    return psa_esp.resolve_config(preset="baseline")
+
+
+def provenance():
+    """What made a run: the build, the model's settings and the versions
+    of the package, pycma and NumPy."""
+    try:
+        import cma
+
+        cma_version = cma.__version__
+    except ImportError:
+        cma_version = None
+    return {
+        "build": psa_esp.build,
+        "model": model(),
+        "versions": {"psa_esp": psa_esp.__version__, "cma": cma_version, "numpy": np.__version__},
+    }
 
 
 def curve_from_records(records):
@@ -126,7 +151,7 @@ def run_all(out: Path, seeds: int, threads: int | None):
                     "curve_step": CURVE_STEP,
                     "curve": curve,
                     "weights": weights.tolist(),
-                    "build": psa_esp.build,
+                    **provenance(),
                 }
                 tmp = path.with_suffix(".tmp")
                 tmp.write_text(json.dumps(row))
@@ -138,8 +163,24 @@ def run_all(out: Path, seeds: int, threads: int | None):
                 )
 
 
+def load_rows(out: Path):
+    """The runs in `out`, all of today's model; exits naming the files of
+    another (or no recorded) model."""
+    paths = sorted(out.glob("*-task*-seed*.json"))
+    rows = [json.loads(p.read_text()) for p in paths]
+    today = model()
+    stale = [p.name for p, r in zip(paths, rows) if r.get("model") != today]
+    if stale:
+        raise SystemExit(
+            f"{len(stale)} of {len(rows)} runs in {out} were made on another model than this build's "
+            f"({psa_esp.build}), or record none: {', '.join(stale[:5])}{' ...' if len(stale) > 5 else ''}. "
+            "Run them again (move them away first)."
+        )
+    return rows
+
+
 def report(out: Path):
-    rows = [json.loads(p.read_text()) for p in sorted(out.glob("*-task*-seed*.json"))]
+    rows = load_rows(out)
     lines = [
         "| task | algorithm | runs | fitness (mean ± se) | score (mean ± se) | t vs ESP, score (df, p) | hidden | s/run |",
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
@@ -167,6 +208,10 @@ def report(out: Path):
                 f"| {score.mean():.2f} ± {se(score):.2f} | {t} | {np.mean([r['hidden'] for r in runs]):.1f} "
                 f"| {np.mean([r['seconds'] for r in runs]):.0f} |"
             )
+    builds = sorted({r["build"] for r in rows})
+    versions = sorted({f"pycma {r['versions']['cma']}, NumPy {r['versions']['numpy']}" for r in rows})
+    lines.append("")
+    lines.append(f"Made on psa-esp {', '.join(builds)} ({'; '.join(versions)}), the model of `psa_esp.resolve_config()`.")
     table = "\n".join(lines)
     (out / "table.md").write_text(table + "\n")
     print(table)

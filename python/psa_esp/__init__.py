@@ -46,6 +46,7 @@ from ._native import (
     resolve_config,
     welch,
 )
+from .env import DEFAULT_STEPS
 from .errors import *  # noqa: F401,F403
 
 TASKS = (1, 2, 3)
@@ -71,17 +72,25 @@ def evolve(
 
     ``callback(record)`` is called after each generation (cycle) with its
     record (the columns of ``records.csv``); returning True stops the run.
-    With ``out`` it writes the run folder ``evolve --out`` writes. Returns
-    the result: ``champion``, ``records`` and ``ending``.
+    With ``out`` it writes the run folder ``evolve --out`` writes.
+    ``seed=None`` draws a fresh seed. Returns the result: ``champion``,
+    ``records``, ``ending`` and ``seed`` (the seed used).
     """
     run = Run(seed=seed, config=config, preset=preset, backend=backend, generations=generations)
-    return run.run_psa(task, callback, eval_path=eval_path, threads=threads, out=out)
+    result = run.run_psa(task, callback, eval_path=eval_path, threads=threads, out=out)
+    result["seed"] = run.seed
+    return result
 
 
 for _task in TASKS:
     _id = f"psa_esp/Task{_task}-v0"
     if _id not in gymnasium.registry:
-        gymnasium.register(id=_id, entry_point="psa_esp.env:PsaEnv", kwargs={"task": _task})
+        gymnasium.register(
+            id=_id,
+            entry_point="psa_esp.env:PsaEnv",
+            kwargs={"task": _task},
+            max_episode_steps=DEFAULT_STEPS,
+        )
 
 __all__ = [
     "GENES_PER_NEURON",

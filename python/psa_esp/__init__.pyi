@@ -30,7 +30,7 @@ def evolve(
     preset: str = "baseline",
     config: Config = None,
     *,
-    seed: int = 1,
+    seed: int | None = 1,
     generations: int | None = None,
     backend: str | None = None,
     eval_path: str = "fastest",

@@ -2,7 +2,7 @@
 
 from collections.abc import Callable, Sequence
 from os import PathLike
-from typing import Any, Literal, Mapping
+from typing import Any, Literal, Mapping, SupportsIndex
 
 import numpy as np
 import numpy.typing as npt
@@ -23,18 +23,21 @@ def evaluate(
     task: int,
     config: Config = None,
     *,
-    seed: int | Sequence[int] | npt.NDArray[np.uint64] | None = None,
-    trials: int | None = None,
+    seed: SupportsIndex | Sequence[SupportsIndex] | npt.NDArray[np.integer[Any]] | None = 1,
+    trials: SupportsIndex | None = None,
     lesioned: npt.NDArray[np.bool_] | None = None,
     preset: str = "baseline",
     backend: Literal["ode", "native", "rapier"] | None = None,
     eval_path: str = "fastest",
-    threads: int | None = None,
-) -> npt.NDArray[np.float64]:
+    threads: SupportsIndex | None = None,
+    return_seed: bool = False,
+) -> Any:
     """The fitness of every network in ``weights`` (networks, hidden, 11)
-    or (networks, hidden * 11) on ``task``, in % of the task's maximum:
-    network j flown as ``psa-esp replay --seed seed[j]`` flies it, the same
-    bits. Batched on the crate's threads with the GIL released."""
+    or (networks, hidden * 11), float64 or float32, on ``task``, in % of
+    the task's maximum: network j flown as ``psa-esp replay --seed
+    seed[j]`` flies it, the same bits. ``seed=None`` draws a fresh seed;
+    ``return_seed=True`` returns ``(fitness, seed)``. Batched on the
+    crate's threads with the GIL released."""
 
 def reference_evaluations_per_second(
     weights: Weights,
@@ -81,17 +84,17 @@ class Run:
 
     def __init__(
         self,
-        algorithm: Literal["esp", "hill_climb"] | None = None,
+        algorithm: Literal["esp", "hill_climb", "hill-climb"] | None = None,
         *,
-        seed: int = 1,
+        seed: SupportsIndex | None = 1,
         config: Config = None,
         preset: str = "baseline",
         backend: str | None = None,
-        inputs: int = 7,
-        outputs: int = 4,
-        generations: int | None = None,
+        inputs: SupportsIndex | None = None,
+        outputs: SupportsIndex | None = None,
+        generations: SupportsIndex | None = None,
         goal: float | None = None,
-        max_evaluations: int | None = None,
+        max_evaluations: SupportsIndex | None = None,
     ) -> None: ...
     def ask(self) -> Asked | None:
         """The networks to evaluate next, or None once the run has ended."""
@@ -112,7 +115,8 @@ class Run:
     def config(self) -> str:
         """The run's whole configuration as TOML."""
     def result(self) -> Result:
-        """``champion``, ``records``, ``ending``; NotEndedError before the end."""
+        """``champion``, ``records``, ``ending``; during the run the best
+        so far (``ending`` None); NotEndedError before any network is told."""
     def evaluate_psa(
         self, asked: Asked, task: int, *, eval_path: str = "fastest", threads: int | None = None
     ) -> npt.NDArray[np.float64]:
@@ -218,6 +222,12 @@ class Trial:
     def state(self) -> list[float]: ...
     @property
     def target(self) -> list[float]: ...
+    @property
+    def dt(self) -> float: ...
+    @property
+    def observation_bounds(self) -> tuple[list[float], list[float]]: ...
+    def frame(self) -> npt.NDArray[np.uint8]:
+        """The trial so far drawn as ``psa-esp replay``'s picture, (H, W, 3)."""
 
 def welch(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float]:
     """Welch's two-sample, two-tailed t-test of ``a`` against ``b``, as

@@ -3,19 +3,28 @@
 ``gymnasium.make("psa_esp/Task1-v0")`` (after ``import psa_esp``), or
 ``PsaEnv(task, config=...)``:
 
-- the observation is the network's 7 inputs (position x and y relative
-  to the target, velocity, heading error, spin, bias), scaled as the model
-  scales them, with input noise where configured;
-- the action is the four thrusters' commands, each clamped to [0, 1] after
-  the output noise, if any;
+- the observation is the network's 7 inputs, in this order: x and y of
+  the position relative to the target, vx and vy (the velocity), the
+  heading input (the heading error, wrapped), omega (the spin) and the
+  bias, each scaled as the model scales it, with input noise where
+  configured; the observation space bounds the heading input and the bias
+  where no noise reaches them;
+- the action is the four thrusters' commands (thrusters 0 to 3), each
+  clamped to [0, 1] after the output noise, if any;
 - the reward is the step's increment of the evolution fitness, in % of
   the task's theoretical maximum, so that an episode's rewards add up to
   the trial's fitness (``info["fitness"]`` holds it exactly: after the
   last step, the bits :func:`psa_esp.evaluate` gives for one trial);
-- an episode is one trial: truncated after its steps (500 by default);
+  ``info["state"]`` is the body's true state: x, y (m), heading (rad),
+  vx, vy (m/s), omega (rad/s);
+- an episode is one trial: truncated after its steps (500 by default, the
+  spec's ``max_episode_steps``);
 - ``reset(seed=S)`` starts the trial as ``psa-esp replay --seed S`` starts
   its first: the paper's start, or a random one when the configuration
-  (or ``random_init=True``) asks for it.
+  (or ``random_init=True``) asks for it;
+- ``render_mode="rgb_array"``: ``render()`` draws the trial so far as
+  ``psa-esp replay`` draws its picture, an (H, W, 3) uint8 array;
+- it pickles (and copies) mid-episode: the copy flies on as the original.
 """
 
 from __future__ import annotations
@@ -28,20 +37,29 @@ from gymnasium import spaces
 
 from ._native import INPUTS, OUTPUTS, Trial
 
+#: The trial's length in steps under the default configuration: the
+#: registered environments' ``max_episode_steps``.
+DEFAULT_STEPS = 500
+
 
 class PsaEnv(gymnasium.Env):
     """One task of the PSA; see the module's documentation."""
 
-    metadata: dict[str, Any] = {"render_modes": []}
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 20}
 
     def __init__(self, task=1, config=None, *, preset="baseline", backend=None, random_init=None, render_mode=None):
-        if render_mode is not None:
-            raise ValueError(f"PsaEnv renders nothing (render_mode must be None, got {render_mode!r})")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"PsaEnv renders only 'rgb_array' frames (render_mode None or 'rgb_array', got {render_mode!r})")
         self.task = task
+        self._arguments = {"task": task, "config": config, "preset": preset, "backend": backend, "random_init": random_init}
         self._trial = Trial(task, config, preset=preset, backend=backend, random_init=random_init)
-        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(INPUTS,), dtype=np.float64)
+        low, high = self._trial.observation_bounds
+        self.observation_space = spaces.Box(np.array(low), np.array(high), shape=(INPUTS,), dtype=np.float64)
         self.action_space = spaces.Box(0.0, 1.0, shape=(OUTPUTS,), dtype=np.float64)
-        self.render_mode = None
+        self.render_mode = render_mode
+        self.metadata = {**PsaEnv.metadata, "render_fps": 1.0 / self._trial.dt}
+        self._trial_seed = None
+        self._actions = []
 
     @property
     def steps(self) -> int:
@@ -51,14 +69,46 @@ class PsaEnv(gymnasium.Env):
     def reset(self, *, seed=None, options=None):
         """Starts a trial. With ``seed``, the trial ``replay --seed seed``
         flies first; without, one drawn from the environment's generator."""
+        limit = self.spec.max_episode_steps if self.spec is not None else None
+        if limit is not None and limit != self.steps:
+            raise ValueError(
+                f"the environment's spec truncates episodes at {limit} steps but its trials last {self.steps}: "
+                f"pass max_episode_steps={self.steps} to gymnasium.make"
+            )
         super().reset(seed=seed)
         trial_seed = int(seed) if seed is not None else int(self.np_random.integers(0, 2**63))
         observation = self._trial.reset(trial_seed)
+        self._trial_seed, self._actions = trial_seed, []
         return observation, {"fitness": 0.0, "trial_seed": trial_seed, "state": self._trial.state}
 
     def step(self, action):
         """One control step: the thrusters' commands for 0.05 s."""
-        observation, reward = self._trial.step(np.asarray(action, dtype=np.float64).reshape(OUTPUTS))
+        action = np.array(action, dtype=np.float64).reshape(OUTPUTS)
+        observation, reward = self._trial.step(action)
+        self._actions.append(action)
         truncated = self._trial.done
         info = {"fitness": self._trial.fitness, "state": self._trial.state}
         return observation, reward, False, truncated, info
+
+    def render(self):
+        """The trial so far as an (H, W, 3) uint8 array under
+        ``render_mode="rgb_array"``; None without a render mode."""
+        if self.render_mode is None:
+            return None
+        return self._trial.frame()
+
+    def __getstate__(self):
+        # The saved form: the arguments, the trial's seed and the actions
+        # applied since; the trial itself (a physics world) is flown again.
+        state = self.__dict__.copy()
+        del state["_trial"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        arguments = dict(self._arguments)
+        self._trial = Trial(arguments.pop("task"), arguments.pop("config"), **arguments)
+        if self._trial_seed is not None:
+            self._trial.reset(self._trial_seed)
+            for action in self._actions:
+                self._trial.step(action)

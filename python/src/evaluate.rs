@@ -12,13 +12,13 @@ use esp_neuroevolution::rayon::prelude::*;
 use esp_neuroevolution::rayon::ThreadPool;
 use esp_neuroevolution::rng::{stream, Stream};
 use esp_neuroevolution::{evaluate_all, Evaluator};
-use numpy::{IntoPyArray, PyArray1};
+use numpy::IntoPyArray;
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
 use psa_sim::psa::{PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyInt;
 
+use crate::args::{self, SeedArg};
 use crate::config::{run_config, type_name};
 use crate::errors;
 use crate::weights::networks_from;
@@ -29,9 +29,19 @@ use crate::weights::networks_from;
 /// does. The tests hold the two to the same bits.
 pub const REPLAY_STREAM: u64 = 301;
 
+/// The seed `evaluate` flies with when none is given: `psa-esp replay`'s
+/// default.
+pub const DEFAULT_SEED: u64 = 1;
+
 /// The task numbered `task`, or a `ValueError`.
 pub fn task_of(task: u8) -> PyResult<Task> {
     Task::try_from(task).map_err(PyValueError::new_err)
+}
+
+/// The task numbered by the argument `task` (an int or a NumPy integer).
+pub fn task_arg(task: &Bound<'_, PyAny>) -> PyResult<Task> {
+    let number = args::count(task, "task")?;
+    task_of(u8::try_from(number).map_err(|_| PyValueError::new_err(format!("task must be 1, 2 or 3, got {number}")))?)
 }
 
 /// The evaluation path named `name`, or a `ValueError` listing the names.
@@ -59,25 +69,31 @@ pub fn pool(threads: Option<usize>) -> PyResult<Arc<ThreadPool>> {
 
 /// One seed for every network, or a seed per network.
 fn seeds(seed: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<u64>> {
-    let bad = |what: String| PyValueError::new_err(format!("seed: {what}; a seed is an integer in [0, 2**64)"));
-    if seed.cast::<PyInt>().is_ok() {
-        let one: u64 = seed.extract().map_err(|_| bad(format!("{seed} is out of range")))?;
-        return Ok(vec![one; count]);
+    if args::is_integer(seed) || seed.cast::<pyo3::types::PyFloat>().is_ok() {
+        return Ok(vec![args::seed(seed, "seed")?; count]);
     }
-    if seed.cast::<pyo3::types::PyFloat>().is_ok() || seed.cast::<pyo3::types::PyString>().is_ok() {
+    if seed.cast::<pyo3::types::PyString>().is_ok() {
         return Err(PyTypeError::new_err(format!(
             "seed must be an int or a sequence of one int per network, got {}",
             type_name(seed)
         )));
     }
-    let many: Vec<u64> = seed.extract().map_err(|_| {
+    let items: Vec<Bound<'_, PyAny>> = seed.try_iter().and_then(|items| items.collect()).map_err(|_| {
         PyTypeError::new_err(format!(
             "seed must be an int or a sequence of one non-negative int per network, got {}",
             type_name(seed)
         ))
     })?;
+    let many = items
+        .iter()
+        .enumerate()
+        .map(|(j, item)| args::seed(item, &format!("seed[{j}]")))
+        .collect::<PyResult<Vec<u64>>>()?;
     if many.len() != count {
-        return Err(bad(format!("{} seeds for {count} networks", many.len())));
+        return Err(PyValueError::new_err(format!(
+            "seed: {} seeds for {count} networks; a seed is an integer in [0, 2**64)",
+            many.len()
+        )));
     }
     Ok(many)
 }
@@ -143,9 +159,12 @@ fn problem(
 /// `config` is a dict of settings (`{"problem": {"noise": {"input_sd":
 /// 0.05}}}`) or the path of a TOML file (a run's `config.toml`), laid over
 /// `preset` on the `native` backend; `trials` and `backend` replace the
-/// configuration's. Network `j` is flown with the seed `seed` (an int) or
-/// `seed[j]` (one per network), exactly as `psa-esp replay NETWORK.json
-/// --seed S --trials K` flies it: the same bits. The networks are flown
+/// configuration's. Network `j` is flown with the seed `seed` (an int,
+/// 1 if left out) or `seed[j]` (one per network), exactly as `psa-esp
+/// replay NETWORK.json --seed S --trials K` flies it: the same bits.
+/// `seed=None` draws a fresh seed from the system's entropy; with
+/// `return_seed=True` the result is `(fitness, seed)`, the seed as used,
+/// to fly the same noise again. The networks are flown
 /// on `eval_path` (`"fastest"`: native's batched SIMD path) on `threads`
 /// threads (None: one per core), with the GIL released.
 ///
@@ -154,35 +173,46 @@ fn problem(
 /// or a bad task, seed or path, `ConfigError` for an unknown or
 /// out-of-range setting, `SimulationError` if the simulator fails.
 #[pyfunction]
-#[pyo3(signature = (weights, task, config=None, *, seed=None, trials=None, lesioned=None, preset="baseline", backend=None, eval_path="fastest", threads=None))]
+#[pyo3(signature = (weights, task, config=None, *, seed=SeedArg::Default, trials=None, lesioned=None, preset="baseline", backend=None, eval_path="fastest", threads=None, return_seed=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<'py>(
     py: Python<'py>,
     weights: &Bound<'py, PyAny>,
-    task: u8,
+    task: &Bound<'py, PyAny>,
     config: Option<&Bound<'py, PyAny>>,
-    seed: Option<&Bound<'py, PyAny>>,
-    trials: Option<usize>,
+    seed: SeedArg<'py>,
+    trials: Option<&Bound<'py, PyAny>>,
     lesioned: Option<&Bound<'py, PyAny>>,
     preset: &str,
     backend: Option<&str>,
     eval_path: &str,
-    threads: Option<usize>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let task = task_of(task)?;
+    threads: Option<&Bound<'py, PyAny>>,
+    return_seed: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let task = task_arg(task)?;
     let path = self::eval_path(eval_path)?;
     let networks = networks_from(weights, INPUT_COUNT, THRUSTER_COUNT, lesioned, false)?;
-    let seeds = match seed {
-        None => vec![1; networks.len()],
-        Some(seed) => seeds(seed, networks.len())?,
+    let seed = match seed {
+        SeedArg::Default => DEFAULT_SEED.into_pyobject(py)?.into_any(),
+        SeedArg::Given(seed) if seed.is_none() => args::fresh_seed(py)?.into_pyobject(py)?.into_any(),
+        SeedArg::Given(seed) => seed,
     };
+    let seeds = seeds(&seed, networks.len())?;
+    let trials = args::optional_count(trials, "trials")?;
+    let threads = args::optional_count(threads, "threads")?;
     let problem = problem(config, preset, backend, trials)?;
     let evaluator = PsaEvaluator::new(problem, task, &path).map_err(errors::config_chain)?;
     let pool = pool(threads)?;
     let fitness = py
         .detach(|| pool.install(|| evaluate_networks(&evaluator, &networks, &seeds)))
-        .map_err(errors::simulation)?;
-    Ok(fitness.into_pyarray(py))
+        .map_err(errors::simulation)?
+        .into_pyarray(py)
+        .into_any();
+    if return_seed {
+        Ok((fitness, seed).into_pyobject(py)?.into_any())
+    } else {
+        Ok(fitness)
+    }
 }
 
 /// The reference of the benchmark of `evaluate`: networks evaluated per

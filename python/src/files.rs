@@ -9,7 +9,8 @@ use esp_neuroevolution::rng::stream;
 use numpy::{PyArray1, PyArray2};
 use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::RunConfig;
-use psa_sim::psa::limits::{check_as, MAX_TRIALS};
+use psa_sim::named::Named;
+use psa_sim::psa::settings::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -160,6 +161,11 @@ impl Network {
         self.file.save(&path).map_err(errors::network_file)
     }
 
+    /// Pickles (and copies) through the network file's JSON.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((restorer(py, "_network_from_json")?, (self.to_json()?,)))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<psa_esp.Network {} hidden neurons, task {}>",
@@ -167,6 +173,21 @@ impl Network {
             self.file.task
         )
     }
+}
+
+/// The network of a network file's JSON text (what `Network.to_json`
+/// gives): how a `Network` unpickles.
+#[pyfunction]
+pub fn _network_from_json(text: &str) -> PyResult<Network> {
+    let (file, network) =
+        NetworkFile::parse(text, std::path::Path::new("<pickled network>")).map_err(errors::network_file)?;
+    Ok(Network { file, network })
+}
+
+/// The function of `psa_esp._native` named `name`, which restores an
+/// object from its saved form (what `__reduce__` gives pickle).
+pub fn restorer<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    py.import("psa_esp._native")?.getattr(name)
 }
 
 /// Reads a network file (`champion.json`, or any file `save` wrote),

@@ -14,6 +14,7 @@
 
 use pyo3::prelude::*;
 
+mod args;
 mod config;
 mod errors;
 mod evaluate;
@@ -33,6 +34,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(files::load_network, m)?)?;
     m.add_function(wrap_pyfunction!(files::replay, m)?)?;
     m.add_function(wrap_pyfunction!(stats::welch, m)?)?;
+    m.add_function(wrap_pyfunction!(files::_network_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(run::_run_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(run::_asked_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(run::_ticket_from_json, m)?)?;
     m.add_class::<files::Network>()?;
     m.add_class::<run::Run>()?;
     m.add_class::<run::Asked>()?;

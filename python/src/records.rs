@@ -55,10 +55,18 @@ pub fn champion<'py>(py: Python<'py>, c: &Champion) -> PyResult<Bound<'py, PyDic
 
 /// A run's result: `champion`, `records` and `ending`.
 pub fn result<'py>(py: Python<'py>, r: &RunResult) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("champion", champion(py, &r.champion)?)?;
-    let records = r.records.iter().map(|x| record(py, x)).collect::<PyResult<Vec<_>>>()?;
-    d.set_item("records", records)?;
+    let d = so_far(py, &r.champion, &r.records)?;
     d.set_item("ending", ending(r.ending))?;
+    Ok(d)
+}
+
+/// A run's result while it goes on: the best network so far, the records
+/// so far, and `ending` None.
+pub fn so_far<'py>(py: Python<'py>, best: &Champion, records: &[GenerationRecord]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("champion", champion(py, best)?)?;
+    let records = records.iter().map(|x| record(py, x)).collect::<PyResult<Vec<_>>>()?;
+    d.set_item("records", records)?;
+    d.set_item("ending", py.None())?;
     Ok(d)
 }

@@ -5,18 +5,21 @@
 use std::path::PathBuf;
 
 use esp_neuroevolution::network::{Network, NetworkSet};
-use esp_neuroevolution::{AnyRun, AskPurpose, AskTell, Esp, GenerationRecord, HillClimb, RunResult, StopAt};
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray};
+use esp_neuroevolution::{AnyRun, AskPurpose, AskTell, Esp, GenerationRecord, HillClimb, RunError, RunResult, StopAt};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use psa_experiment::{Algorithm, RunConfig, RunStart};
 use psa_sim::evaluator::PsaEvaluator;
-use psa_sim::psa::NetworkFile;
+use psa_sim::named::Named;
+use psa_sim::psa::{NetworkFile, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::args::{self, SeedArg};
 use crate::config::{run_config, type_name};
-use crate::evaluate::{eval_path, pool, task_of};
-use crate::weights::arrays_of;
+use crate::evaluate::{eval_path, pool, task_arg, task_of, DEFAULT_SEED};
+use crate::files::restorer;
+use crate::weights::{arrays_of, float_array, networks_from};
 use crate::{errors, records};
 
 /// The `format` of a saved run.
@@ -33,11 +36,32 @@ pub struct Ticket {
     inner: esp_neuroevolution::Ticket,
 }
 
+impl Ticket {
+    /// The ticket's saved form: its run's and its ask's numbers.
+    fn saved(&self) -> PyResult<serde_json::Value> {
+        serde_json::to_value(self.inner).map_err(|e| errors::restore(e.to_string()))
+    }
+}
+
 #[pymethods]
 impl Ticket {
-    fn __repr__(&self) -> String {
-        format!("<psa_esp.Ticket {:?}>", self.inner)
+    /// Pickles (and copies) through the crate's serde: a ticket pickled
+    /// with its ask to another process tells the run it came from.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((restorer(py, "_ticket_from_json")?, (self.saved()?.to_string(),)))
     }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let saved = self.saved()?;
+        Ok(format!("<psa_esp.Ticket ask {} of run {}>", saved["ask"], saved["run"]))
+    }
+}
+
+/// The ticket of a ticket's saved form: how a `Ticket` unpickles.
+#[pyfunction]
+pub fn _ticket_from_json(text: &str) -> PyResult<Ticket> {
+    let inner = serde_json::from_str(text).map_err(|e| errors::restore(format!("cannot restore the ticket: {e}")))?;
+    Ok(Ticket { inner })
 }
 
 /// The networks a run asks to have evaluated.
@@ -117,14 +141,88 @@ impl Asked {
         self.networks.len()
     }
 
+    /// Pickles (and copies) through its saved form: the ticket, the
+    /// purpose, the random streams and the arrays; the networks are the
+    /// arrays' again, bit for bit.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            Ticket,
+            String,
+            u64,
+            Vec<u64>,
+            Py<PyArray3<f64>>,
+            Py<PyArray2<bool>>,
+            usize,
+        ),
+    )> {
+        let purpose = serde_json::to_string(&self.purpose).map_err(|e| errors::restore(e.to_string()))?;
+        let inputs = self.networks.first().map_or(0, |n| n.inputs());
+        Ok((
+            restorer(py, "_asked_from_state")?,
+            (
+                self.ticket(),
+                purpose,
+                self.seed,
+                self.key.clone(),
+                self.weights(py),
+                self.lesioned(py),
+                inputs,
+            ),
+        ))
+    }
+
     fn __repr__(&self) -> String {
+        let what = match self.purpose {
+            AskPurpose::Generation(g) => format!("generation {g}"),
+            AskPurpose::LesionTest(g) => format!("the lesion test of generation {g}"),
+            AskPurpose::Base => "the base network".to_string(),
+        };
         format!(
-            "<psa_esp.Asked {} networks, {} of generation {:?}>",
+            "<psa_esp.Asked {} networks for {what}, seed {}>",
             self.networks.len(),
-            self.purpose(),
-            self.generation()
+            self.seed
         )
     }
+}
+
+/// The ask of an ask's saved form (`Asked.__reduce__`): how an `Asked`
+/// unpickles.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn _asked_from_state(
+    ticket: &Bound<'_, Ticket>,
+    purpose: &str,
+    seed: u64,
+    key: Vec<u64>,
+    weights: Bound<'_, PyArray3<f64>>,
+    lesioned: Bound<'_, PyArray2<bool>>,
+    inputs: usize,
+) -> PyResult<Asked> {
+    let bad = |e: String| errors::restore(format!("cannot restore the ask: {e}"));
+    let purpose: AskPurpose = serde_json::from_str(purpose).map_err(|e| bad(e.to_string()))?;
+    let genes = weights.shape()[2];
+    let outputs = genes
+        .checked_sub(inputs)
+        .ok_or_else(|| bad(format!("{inputs} inputs of {genes} genes")))?;
+    let networks = if weights.shape()[0] == 0 {
+        Vec::new()
+    } else {
+        networks_from(weights.as_any(), inputs, outputs, Some(lesioned.as_any()), false)?
+    };
+    Ok(Asked {
+        ticket: ticket.get().inner,
+        purpose,
+        seed,
+        key,
+        networks,
+        weights: weights.unbind(),
+        lesioned: lesioned.unbind(),
+    })
 }
 
 /// A run of ESP or of the hill-climber, driven from Python.
@@ -151,16 +249,11 @@ pub struct Run {
     run: AnyRun,
 }
 
-/// `fitness` as told: a float64 array of one dimension, or a sequence of
-/// numbers.
+/// `fitness` as told: a float64 (or float32) array of one dimension, or
+/// a sequence of numbers.
 fn fitness_values(fitness: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    if let Ok(array) = fitness.cast::<PyUntypedArray>() {
-        let typed = array.cast::<numpy::PyArrayDyn<f64>>().map_err(|_| {
-            PyTypeError::new_err(format!(
-                "fitness must be a float64 array, got dtype {}",
-                numpy::PyUntypedArrayMethods::dtype(array)
-            ))
-        })?;
+    if fitness.cast::<PyUntypedArray>().is_ok() {
+        let typed = float_array(fitness, "fitness")?;
         let readonly = typed.try_readonly().map_err(|e| PyValueError::new_err(e.to_string()))?;
         let view = readonly.as_array();
         if view.ndim() != 1 {
@@ -177,6 +270,18 @@ fn fitness_values(fitness: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
             type_name(fitness)
         ))
     })
+}
+
+/// The algorithm named `name`: `"esp"`, or `"hill_climb"` (also spelt
+/// `"hill-climb"`, as its preset is).
+fn algorithm_named(name: &str) -> PyResult<Algorithm> {
+    match name {
+        "esp" => Ok(Algorithm::Esp),
+        "hill_climb" | "hill-climb" => Ok(Algorithm::HillClimb),
+        other => Err(PyValueError::new_err(format!(
+            "algorithm must be \"esp\" or \"hill_climb\" (or \"hill-climb\"), got {other:?}"
+        ))),
+    }
 }
 
 impl Run {
@@ -231,31 +336,32 @@ impl Run {
 #[pymethods]
 impl Run {
     #[new]
-    #[pyo3(signature = (algorithm=None, *, seed=1, config=None, preset="baseline", backend=None, inputs=7, outputs=4, generations=None, goal=None, max_evaluations=None))]
+    #[pyo3(signature = (algorithm=None, *, seed=SeedArg::Default, config=None, preset="baseline", backend=None, inputs=None, outputs=None, generations=None, goal=None, max_evaluations=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
+        py: Python<'_>,
         algorithm: Option<&str>,
-        seed: u64,
+        seed: SeedArg<'_>,
         config: Option<&Bound<'_, PyAny>>,
         preset: &str,
         backend: Option<&str>,
-        inputs: usize,
-        outputs: usize,
-        generations: Option<usize>,
+        inputs: Option<&Bound<'_, PyAny>>,
+        outputs: Option<&Bound<'_, PyAny>>,
+        generations: Option<&Bound<'_, PyAny>>,
         goal: Option<f64>,
-        max_evaluations: Option<u64>,
+        max_evaluations: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Run> {
+        let seed = match seed {
+            SeedArg::Default => DEFAULT_SEED,
+            SeedArg::Given(seed) => args::seed_or_fresh(py, Some(&seed), "seed")?,
+        };
+        let inputs = args::optional_count(inputs, "inputs")?.unwrap_or(INPUT_COUNT);
+        let outputs = args::optional_count(outputs, "outputs")?.unwrap_or(THRUSTER_COUNT);
+        let generations = args::optional_count(generations, "generations")?;
+        let max_evaluations = args::optional_count(max_evaluations, "max_evaluations")?.map(|n| n as u64);
         let mut config = run_config(config, preset, backend)?;
         if let Some(algorithm) = algorithm {
-            config.algorithm = match algorithm {
-                "esp" => Algorithm::Esp,
-                "hill_climb" => Algorithm::HillClimb,
-                other => {
-                    return Err(PyValueError::new_err(format!(
-                        "algorithm must be \"esp\" or \"hill_climb\", got {other:?}"
-                    )))
-                }
-            };
+            config.algorithm = algorithm_named(algorithm)?;
         }
         if let Some(generations) = generations {
             config.set_generations(generations).map_err(errors::config_chain)?;
@@ -356,11 +462,17 @@ impl Run {
         self.config.to_toml().map_err(errors::config_chain)
     }
 
-    /// The ended run's result: `champion` (`weights`, `lesioned`,
-    /// `fitness`, `generation`, `evaluation`), `records` and `ending`.
-    /// Raises `NotEndedError` before it has ended.
+    /// The run's result: `champion` (`weights`, `lesioned`, `fitness`,
+    /// `generation`, `evaluation`), `records` and `ending`. While the run
+    /// goes on, the best network so far (as pycma's `result`), with
+    /// `ending` None; raises `NotEndedError` before any network has been
+    /// told.
     fn result<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        records::result(py, &self.ended()?)
+        if self.run.ending().is_some() {
+            return records::result(py, &self.ended()?);
+        }
+        let champion = self.run.champion().ok_or_else(|| errors::run(RunError::NotEnded))?;
+        records::so_far(py, champion, self.run.records())
     }
 
     /// The fitness of `asked`'s networks on `task` under the run's
@@ -371,18 +483,18 @@ impl Run {
         &self,
         py: Python<'py>,
         asked: &Bound<'py, Asked>,
-        task: u8,
+        task: &Bound<'py, PyAny>,
         eval_path: &str,
-        threads: Option<usize>,
+        threads: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let asked = asked.get();
         let evaluator = PsaEvaluator::new(
             self.config.problem.clone(),
-            task_of(task)?,
+            task_arg(task)?,
             &self::eval_path(eval_path)?,
         )
         .map_err(errors::config_chain)?;
-        let pool = pool(threads)?;
+        let pool = pool(args::optional_count(threads, "threads")?)?;
         let fitness = py
             .detach(|| {
                 pool.install(|| {
@@ -404,16 +516,16 @@ impl Run {
     fn run_psa<'py>(
         &mut self,
         py: Python<'py>,
-        task: u8,
+        task: &Bound<'py, PyAny>,
         callback: Option<&Bound<'py, PyAny>>,
         eval_path: &str,
-        threads: Option<usize>,
+        threads: Option<&Bound<'py, PyAny>>,
         out: Option<PathBuf>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let task = task_of(task)?;
+        let task = task_arg(task)?;
         let evaluator = PsaEvaluator::new(self.config.problem.clone(), task, &self::eval_path(eval_path)?)
             .map_err(errors::config_chain)?;
-        let pool = pool(threads)?;
+        let pool = pool(args::optional_count(threads, "threads")?)?;
         let mut files = match &out {
             None => None,
             Some(dir) => {
@@ -564,6 +676,12 @@ impl Run {
         .map_err(errors::network_file)
     }
 
+    /// Pickles (and copies) through `to_json`: the copy ends as the run
+    /// would, bit for bit (asks made before are to be asked again).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        Ok((restorer(py, "_run_from_json")?, (self.to_json()?,)))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<psa_esp.Run {} seed {}: {} generations done{}>",
@@ -573,4 +691,10 @@ impl Run {
             self.ending().map_or(String::new(), |e| format!(", {e}"))
         )
     }
+}
+
+/// The run of `Run.to_json`'s text: how a `Run` unpickles.
+#[pyfunction]
+pub fn _run_from_json(text: &str) -> PyResult<Run> {
+    Run::from_json(text)
 }

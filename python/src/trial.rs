@@ -4,17 +4,26 @@
 //! network flown through it scores what `evaluate` gives.
 
 use esp_neuroevolution::rng::stream;
-use numpy::{PyArray1, PyArrayMethods};
+use std::f64::consts::{PI, TAU};
+
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
+use psa_experiment::plots::{trial_frame, TrialPicture, FIGURE_HEIGHT, FIGURE_WIDTH};
+use psa_sim::named::Named;
 use psa_sim::numeric::{clamp_unit, NoiseSource};
-use psa_sim::physics::{create_backend, PhysicsBackend, PlanarState};
+use psa_sim::physics::{create_backend, BodyState, PhysicsBackend, PlanarState};
 use psa_sim::psa::step::{score, sense, Reading};
-use psa_sim::psa::{PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
+use psa_sim::psa::{HeadingWrap, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 use crate::config::{run_config, type_name};
 use crate::errors;
 use crate::evaluate::{task_of, REPLAY_STREAM};
+
+/// The heading input's place among the inputs (x, y, vx, vy, heading,
+/// omega, bias).
+const HEADING_INPUT: usize = 4;
 
 /// A trial under way.
 struct Flight {
@@ -24,6 +33,10 @@ struct Flight {
     reading: Reading<f64>,
     points: f64,
     steps: usize,
+    /// The states flown so far, the start first (for `frame`).
+    states: Vec<BodyState>,
+    /// The thrusters' commands applied so far, after noise and clamping.
+    outputs: Vec<[f64; THRUSTER_COUNT]>,
 }
 
 /// One trial of a task, flown a control step at a time.
@@ -122,6 +135,8 @@ impl Trial {
             reading,
             points: 0.0,
             steps: 0,
+            states: vec![self.backend.state()],
+            outputs: Vec::new(),
         });
         Ok(PyArray1::from_slice(py, &inputs))
     }
@@ -181,6 +196,8 @@ impl Trial {
         flight.reading = next;
         flight.points += points;
         flight.steps += 1;
+        flight.states.push(self.backend.state());
+        flight.outputs.push(outputs);
         Ok((
             PyArray1::from_slice(py, &flight.reading.inputs),
             100.0 * points / maximum,
@@ -204,6 +221,12 @@ impl Trial {
     #[getter]
     fn steps(&self) -> usize {
         self.settings.steps
+    }
+
+    /// Seconds a step lasts.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.settings.physics.dt
     }
 
     /// Whether the trial has flown all its steps.
@@ -232,6 +255,69 @@ impl Trial {
     #[getter]
     fn target(&self) -> PyResult<[f64; 3]> {
         Ok(self.flight.as_ref().ok_or_else(not_started)?.target)
+    }
+
+    /// The bounds of the observation, (low, high), 7 each: the heading
+    /// input lies in its wrap range times its scale and the bias is its
+    /// constant, unless input noise reaches them; the rest are unbounded.
+    #[getter]
+    fn observation_bounds(&self) -> ([f64; INPUT_COUNT], [f64; INPUT_COUNT]) {
+        let mut low = [f64::NEG_INFINITY; INPUT_COUNT];
+        let mut high = [f64::INFINITY; INPUT_COUNT];
+        let s = &self.settings;
+        let noisy = s.noise.input_sd > 0.0;
+        if !noisy {
+            let (from, to) = match s.sensors.heading_wrap {
+                HeadingWrap::Symmetric => (-PI, PI),
+                HeadingWrap::Positive => (0.0, TAU),
+            };
+            let ends = [from * s.sensors.heading_scale, to * s.sensors.heading_scale];
+            low[HEADING_INPUT] = ends[0].min(ends[1]);
+            high[HEADING_INPUT] = ends[0].max(ends[1]);
+        }
+        if !(noisy && s.noise.on_bias) {
+            low[INPUT_COUNT - 1] = s.sensors.bias;
+            high[INPUT_COUNT - 1] = s.sensors.bias;
+        }
+        (low, high)
+    }
+
+    /// The trial so far drawn as `psa-esp replay` draws its picture
+    /// (`trial.png`: the path with the target box, the thrusters'
+    /// commands, the heading error and spin over time), as an (H, W, 3)
+    /// uint8 array. Before the first step it shows the start, held for one
+    /// step without thrust.
+    fn frame<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<u8>>> {
+        let f = self.flight.as_ref().ok_or_else(not_started)?;
+        let s = &self.settings;
+        let held;
+        let (states, outputs): (&[BodyState], &[[f64; THRUSTER_COUNT]]) = if f.outputs.is_empty() {
+            held = ([f.states[0], f.states[0]], [[0.0; THRUSTER_COUNT]]);
+            (&held.0, &held.1)
+        } else {
+            (&f.states, &f.outputs)
+        };
+        let picture = TrialPicture {
+            title: format!(
+                "task {}, {} backend, step {} of {}, fitness {:.1} %",
+                u8::from(self.task),
+                s.backend.name(),
+                f.steps,
+                s.steps,
+                100.0 * f.points / self.maximum
+            ),
+            dt: s.physics.dt,
+            states,
+            outputs,
+            target: f.target,
+            box_half_width: s.fitness.box_half_width,
+            heading_window: s.fitness.heading_window,
+            hull_radius: s.body.hull_radius,
+        };
+        let pixels = trial_frame(&picture).map_err(|e| errors::simulation(format!("{e:#}")))?;
+        let shape = (FIGURE_HEIGHT as usize, FIGURE_WIDTH as usize, 3);
+        let array = Array3::from_shape_vec(shape, pixels).map_err(|e| errors::simulation(e.to_string()))?;
+        Ok(array.into_pyarray(py))
     }
 
     /// The number of inputs (observations).

@@ -14,8 +14,10 @@ use pyo3::prelude::*;
 
 use crate::config::type_name;
 
-/// `value` as a float64 array, or a `TypeError` naming what it is.
-fn float_array<'py>(value: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+/// `value` as a float64 array, or a `TypeError` naming what it is. A
+/// float32 or float16 array (evosax's and EvoTorch's default dtype) is
+/// converted: every such number is a float64 exactly.
+pub fn float_array<'py>(value: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let untyped = value.cast::<PyUntypedArray>().map_err(|_| {
         PyTypeError::new_err(format!(
             "{what} must be a NumPy array of float64, got {} (use numpy.asarray(..., dtype=numpy.float64))",
@@ -23,13 +25,19 @@ fn float_array<'py>(value: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py
         ))
     })?;
     let py = value.py();
-    if !untyped.dtype().is_equiv_to(&dtype::<f64>(py)) {
+    let dtype_of = untyped.dtype();
+    if dtype_of.is_equiv_to(&dtype::<f64>(py)) {
+        return Ok(value.cast::<PyArrayDyn<f64>>()?.clone());
+    }
+    let exact = dtype_of.is_equiv_to(&dtype::<f32>(py)) || dtype_of.kind() == b'f' && dtype_of.itemsize() < 8;
+    if !exact {
         return Err(PyTypeError::new_err(format!(
-            "{what} must be a NumPy array of float64, got dtype {} (convert it with .astype(numpy.float64))",
-            untyped.dtype()
+            "{what} must be a NumPy array of float64 (or float32, converted exactly), got dtype {dtype_of} (convert it with .astype(numpy.float64))"
         )));
     }
-    Ok(value.cast::<PyArrayDyn<f64>>()?.clone())
+    Ok(value
+        .call_method1("astype", ("float64",))?
+        .cast_into::<PyArrayDyn<f64>>()?)
 }
 
 /// The networks of `weights`, an array of shape (networks, hidden,

@@ -104,7 +104,7 @@ def test_no_networks_is_no_fitness():
 @pytest.mark.parametrize(
     ("weights", "error", "words"),
     [
-        (random_networks(3).astype(np.float32), TypeError, "dtype float32"),
+        (random_networks(3).astype(np.int64), TypeError, "dtype int64"),
         (random_networks(3).tolist(), TypeError, "got list"),
         (np.zeros((3, 5, 10)), ValueError, "10 genes per hidden neuron"),
         (np.zeros((3, 54)), ValueError, "not whole hidden neurons"),

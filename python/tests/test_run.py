@@ -250,3 +250,25 @@ def test_network_files_round_trip_and_bad_files_raise(tmp_path):
         psa_esp.Network(np.full((2, 11), np.nan))
     with pytest.raises(ValueError, match="random_init"):
         psa_esp.replay(path, random_init=True)
+
+
+def test_result_during_the_run_is_the_best_so_far():
+    run = psa_esp.Run(seed=5, generations=4)
+    with pytest.raises(psa_esp.NotEndedError):
+        run.result()
+    best = -np.inf
+    for _ in range(2):
+        asked = run.ask()
+        fitness = run.evaluate_psa(asked, 1)
+        run.tell(asked.ticket, fitness)
+        best = max(best, float(fitness.max()))
+    result = run.result()
+    assert result["ending"] is None
+    assert result["champion"]["fitness"] == best
+    assert len(result["records"]) == len(run.records)
+    weights = result["champion"]["weights"]
+    assert psa_esp.evaluate(weights[None], 1, seed=run.seed, trials=None).shape == (1,)
+    final = run.run_psa(1)
+    assert final["champion"]["fitness"] >= best
+    assert run.result()["ending"] == final["ending"] == "completed"
+    assert run.result()["champion"]["fitness"] == final["champion"]["fitness"]

@@ -20,4 +20,4 @@ pub mod trial;
 
 pub use font::{ensure_font, FONT_ENV_VAR, FONT_FAMILY, FONT_PACKAGE};
 pub use picture::TrialPicture;
-pub use trial::write_trial_pictures;
+pub use trial::{trial_frame, write_trial_pictures, FIGURE_HEIGHT, FIGURE_WIDTH};

@@ -61,8 +61,7 @@ pub(crate) fn write_svg_and_png(
     draw_on(drawing, SVGBackend::with_string(&mut svg, size), svg_path)?;
     psa_sim::io::write_atomic(svg_path, svg.as_bytes())?;
     let (width, height) = size;
-    let mut pixels = vec![0u8; width as usize * height as usize * 3];
-    draw_on(drawing, BitMapBackend::with_buffer(&mut pixels, size), png_path)?;
+    let pixels = draw_rgb(drawing, size, png_path)?;
     psa_sim::io::write_atomic_with(png_path, |out| {
         let mut encoder = png::Encoder::new(out, width, height);
         encoder.set_color(png::ColorType::Rgb);
@@ -73,6 +72,14 @@ pub(crate) fn write_svg_and_png(
         Ok(())
     })
     .with_context(|| format!("writing {}", png_path.display()))
+}
+
+/// `drawing` of `size` pixels as RGB bytes, row after row (errors name
+/// `path`, what it is for).
+pub(crate) fn draw_rgb(drawing: &impl Drawing, size: (u32, u32), path: &Path) -> Result<Vec<u8>> {
+    let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
+    draw_on(drawing, BitMapBackend::with_buffer(&mut pixels, size), path)?;
+    Ok(pixels)
 }
 
 /// Draws `drawing` whole onto `backend` (errors name `path`, the file it is for).

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::animation;
 use super::font::ensure_font;
-use super::output::{draw_legend, font, write_svg_and_png, Drawing};
+use super::output::{draw_legend, draw_rgb, font, write_svg_and_png, Drawing};
 use super::picture::{equal_aspect, TrialPicture, THRUSTER_COLORS, THRUSTER_NAMES};
 
 /// Width of the static figure in pixels.
@@ -56,6 +56,20 @@ pub fn write_trial_pictures(picture: &TrialPicture, dir: &Path, stem: &str) -> a
     psa_sim::io::write_atomic(&animation_path, svg.as_bytes())?;
 
     Ok(vec![svg_path, png_path, animation_path])
+}
+
+/// The static figure of `picture` (what [`write_trial_pictures`] writes
+/// as `<stem>.png`) as RGB bytes, row after row, [`FIGURE_WIDTH`] x
+/// [`FIGURE_HEIGHT`] pixels: a frame of a trial under way (the Python
+/// environment's `render()`). Fails as [`write_trial_pictures`] does.
+pub fn trial_frame(picture: &TrialPicture) -> anyhow::Result<Vec<u8>> {
+    picture.validate()?;
+    ensure_font()?;
+    draw_rgb(
+        picture,
+        (FIGURE_WIDTH, FIGURE_HEIGHT),
+        Path::new("a frame of the trial"),
+    )
 }
 
 /// A tick label with `decimals` decimals and no "-0.00".

@@ -30,7 +30,7 @@ pub enum HeadingWrap {
     /// (-pi, pi]: the default before sweep S22.
     Symmetric,
     /// [0, 2 pi): the input jumps by 2 pi where the heading crosses its
-    /// target. `[fitted]` default (docs/model.md, sweeps S21 and S22)
+    /// target. `[fitted]` default (docs/sweeps/s16-s21-s23-heading-range.md)
     #[default]
     Positive,
 }
@@ -63,7 +63,7 @@ pub struct SensorSettings {
     /// What the heading input measures. `[chosen]` error
     pub heading_input: HeadingInput,
     /// The range the heading input is wrapped to. `[fitted]` positive,
-    /// [0, 2 pi) (docs/model.md, sweeps S21 and S22)
+    /// [0, 2 pi) (docs/sweeps/s16-s21-s23-heading-range.md, S21 and S22)
     pub heading_wrap: HeadingWrap,
 }
 
@@ -128,9 +128,9 @@ impl SensorSettings {
         ]
     }
 
-    /// Rejects values outside their [ranges](super::limits).
+    /// Rejects values outside their [ranges](super::settings::limits).
     pub fn validate(&self) -> Result<(), String> {
-        super::limits::check_all(&[
+        super::settings::limits::check_all(&[
             ("sensors.position_scale", self.position_scale),
             ("sensors.velocity_scale", self.velocity_scale),
             ("sensors.heading_scale", self.heading_scale),
@@ -155,9 +155,9 @@ pub struct NoiseSettings {
 }
 
 impl NoiseSettings {
-    /// Rejects deviations outside their [ranges](super::limits).
+    /// Rejects deviations outside their [ranges](super::settings::limits).
     pub fn validate(&self) -> Result<(), String> {
-        super::limits::check_all(&[("noise.input_sd", self.input_sd), ("noise.output_sd", self.output_sd)])
+        super::settings::limits::check_all(&[("noise.input_sd", self.input_sd), ("noise.output_sd", self.output_sd)])
     }
 
     /// Whether any noise is configured.

@@ -6,11 +6,12 @@ use std::fmt;
 
 use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
+use strum::VariantArray;
 
 use crate::physics::BodyState;
 
 /// One of the paper's tasks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, strum::VariantArray)]
 #[serde(try_from = "u8", into = "u8")]
 pub enum Task {
     /// Stop autorotation, hold heading and position.
@@ -22,12 +23,19 @@ pub enum Task {
 }
 
 impl Task {
-    /// All tasks in order.
-    pub const ALL: [Task; 3] = [Task::StopRotation, Task::Turn, Task::StopAtPosition];
-
     /// The task's number, 1 to 3.
     pub fn number(self) -> u8 {
         self as u8
+    }
+
+    /// The tasks' numbers in words, for messages: "1, 2 or 3".
+    fn numbers() -> String {
+        let numbers: Vec<String> = Task::VARIANTS.iter().map(|t| t.number().to_string()).collect();
+        match numbers.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => String::new(),
+        }
     }
 
     /// Whether the paper has a random-initialisation variant (tasks 1 and 3).
@@ -64,7 +72,7 @@ impl Task {
 
     /// Whether the paper ran this task (its tables have a column for it): a
     /// grid's default tasks and the report's comparisons with the paper ask
-    /// this, never [`Task::ALL`]. A task added later answers `false`.
+    /// this, never [`Task::VARIANTS`]. A task added later answers `false`.
     pub fn in_paper(self) -> bool {
         match self {
             Task::StopRotation | Task::Turn | Task::StopAtPosition => true,
@@ -75,12 +83,11 @@ impl Task {
 impl TryFrom<u8> for Task {
     type Error = String;
     fn try_from(n: u8) -> Result<Task, String> {
-        match n {
-            1 => Ok(Task::StopRotation),
-            2 => Ok(Task::Turn),
-            3 => Ok(Task::StopAtPosition),
-            _ => Err(format!("task must be 1, 2 or 3, got {n}")),
-        }
+        Task::VARIANTS
+            .iter()
+            .copied()
+            .find(|task| task.number() == n)
+            .ok_or_else(|| format!("task must be {}, got {n}", Task::numbers()))
     }
 }
 
@@ -96,7 +103,7 @@ impl std::str::FromStr for Task {
         let n: u8 = s
             .trim()
             .parse()
-            .map_err(|_| format!("task must be 1, 2 or 3, got {s:?}"))?;
+            .map_err(|_| format!("task must be {}, got {s:?}", Task::numbers()))?;
         Task::try_from(n)
     }
 }
@@ -124,27 +131,27 @@ pub struct Target {
 pub struct TaskSettings {
     /// Task 1: initial spin (rad/s). `[fitted]` 1.0: the paper's Table 1
     /// and 2 levels for task 1 with champions scored on the original
-    /// fitness (docs/model.md, sweeps S10 and S14)
+    /// fitness (docs/sweeps/s10-task1-spin.md, s14-s15-starts-original-scoring.md)
     pub task1_spin: f64,
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
     /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
     /// turning when the trial starts. `[fitted]` -1.5, clockwise, away from
     /// the target: the whole distance to the paper (Table 1 and 2 for task
-    /// 2 with their spreads, the burst totals and their ratio; docs/model.md,
-    /// sweeps S24 and S33-S35)
+    /// 2 with their spreads, the burst totals and their ratio;
+    /// docs/sweeps/s24-s33-s35-task2-start.md)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
     /// Task 3: initial forward (+y) speed (m/s). `[fitted]` 0.4: the paper's
-    /// Table 1 and 2 levels for task 3 (docs/model.md, sweep S17)
+    /// Table 1 and 2 levels for task 3 (docs/sweeps/s17-task3-speed.md)
     pub task3_speed: f64,
     /// Task 3: distance of the target along +y (m). `[fitted]` 0.40, the
     /// middle of the random starts' range: both ends fit Tables 1 and 2 worse
-    /// (docs/model.md, sweep S20)
+    /// (docs/sweeps/s20-task3-distance.md)
     pub task3_distance: f64,
     /// Task 3: target heading (rad). `[fitted]` 0, the start heading: the
-    /// PSA turns round to brake and back again (docs/model.md)
+    /// PSA turns round to brake and back again (docs/sweeps/s02-s06-task3-target-heading.md)
     pub task3_target_heading: f64,
     /// Task 3, random initialisation: target distance range (m). `[paper]` [0.25, 0.55]
     pub task3_random_distance: [f64; 2],
@@ -166,11 +173,11 @@ impl Default for TaskSettings {
 }
 
 impl TaskSettings {
-    /// Rejects values outside their [ranges](super::limits) and an empty
+    /// Rejects values outside their [ranges](super::settings::limits) and an empty
     /// distance range.
     pub fn validate(&self) -> Result<(), String> {
         let [lo, hi] = self.task3_random_distance;
-        super::limits::check_all(&[
+        super::settings::limits::check_all(&[
             ("tasks.task1_spin", self.task1_spin),
             ("tasks.task2_target_heading", self.task2_target_heading),
             ("tasks.task2_spin", self.task2_spin),
