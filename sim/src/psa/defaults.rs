@@ -82,6 +82,7 @@ pub const CHANGES: &[Change] = &[
     first("problem.sensors.heading_wrap", r#""symmetric""#),
     changed("problem.sensors.heading_wrap", "a70d696", r#""positive""#),
     first("problem.noise.on_bias", "false"),
+    first("problem.noise.stage", r#""scaled""#),
     first("problem.tasks.task1_spin", "1.0"),
     changed("problem.tasks.task1_spin", "e34b1bb", "2.0"),
     changed("problem.tasks.task1_spin", "d497677", "1.0"),

@@ -15,7 +15,7 @@
 use std::fmt;
 
 use super::fitness::{FitnessKind, FitnessState, Scoring, SlowingRule};
-use super::sensors::{HeadingInput, HeadingWrap};
+use super::sensors::{HeadingInput, HeadingWrap, NoiseStage};
 use super::task::Task;
 use super::trial::PsaSettings;
 
@@ -204,6 +204,26 @@ pub const READINGS: &[Reading] = &[
             )]
         }),
         set_test_value: |s| s.noise.on_bias = true,
+    },
+    Reading {
+        key: "noise.stage",
+        doc: "where the input noise enters: `scaled` (on the inputs, in input units) or `raw` (on what the sensors measure, before scaling)",
+        tag: Tag::Chosen,
+        define: Some(Define {
+            name: "PSA_NOISE_RAW",
+            on: |s| s.noise.stage == NoiseStage::Raw,
+        }),
+        task_key: None,
+        describe: Describe::Lines(|s, _| {
+            vec![format!(
+                "input noise: {}",
+                match s.noise.stage {
+                    NoiseStage::Scaled => "on the scaled inputs",
+                    NoiseStage::Raw => "on what the sensors measure, before scaling",
+                }
+            )]
+        }),
+        set_test_value: |s| s.noise.stage = NoiseStage::Raw,
     },
     Reading {
         key: "fitness.state",
