@@ -82,7 +82,6 @@ pub const CHANGES: &[Change] = &[
     first("problem.sensors.heading_wrap", r#""symmetric""#),
     changed("problem.sensors.heading_wrap", "a70d696", r#""positive""#),
     first("problem.noise.on_bias", "false"),
-    first("problem.noise.stage", r#""scaled""#),
     first("problem.tasks.task1_spin", "1.0"),
     changed("problem.tasks.task1_spin", "e34b1bb", "2.0"),
     changed("problem.tasks.task1_spin", "d497677", "1.0"),
@@ -108,6 +107,7 @@ pub const CHANGES: &[Change] = &[
     first("hill_climb.alpha", "1.0"),
     changed("hill_climb.alpha", "", "0.3"),
     changed("problem.tasks.task2_spin", "", "-1.5"),
+    first("problem.noise.stage", r#""scaled""#),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.
