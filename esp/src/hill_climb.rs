@@ -43,7 +43,7 @@ pub struct HillClimbSettings {
     /// Bounds: [0, 1].
     pub p_noise: f64,
     /// Scale of that noise (alpha). Default 0.3 `[chosen]`, ESP's own
-    /// Cauchy scale (the paper's parallel; docs/model.md, sweep S26).
+    /// Cauchy scale (the paper's parallel; psa-esp's docs/sweeps/s26-hill-climber.md).
     /// Bounds: (0, 1e6].
     pub alpha: f64,
     /// Probability that a weight then changes sign. Default 0.05

@@ -45,7 +45,8 @@ impl Default for RunConfig {
 /// Høverstad's ESP with 5 sub-populations of 40 neurons at first, 10
 /// networks per neuron (400 a generation) and 2000 generations; the
 /// stagnation of 50 generations is fitted to the paper's burst totals
-/// (docs/model.md, sweeps S5, S22, S23 and S28).
+/// (docs/sweeps/s05-stagnation-b.md, s16-s21-s23-heading-range.md and
+/// s28-stagnation-b-spreads.md).
 pub fn paper_esp_settings() -> EspSettings {
     EspSettings {
         subpop_size: 40,

@@ -34,7 +34,7 @@ pub enum Scoring {
     /// Høverstad's incremental fitness, whatever evolution used.
     Incremental,
     /// Sit's original fitness, whatever evolution used. `[fitted]` default
-    /// (docs/model.md, sweeps S12-S15)
+    /// (docs/sweeps/s12-scoring-readings.md, S12; s14-s15-starts-original-scoring.md, S14, S15)
     #[default]
     Original,
 }
@@ -60,7 +60,7 @@ pub enum FitnessState {
     #[serde(rename = "truth", alias = "true")]
     True,
     /// The sensed ones: under input noise the fitness sees the noise too.
-    /// `[fitted]` default (docs/model.md, sweep S12)
+    /// `[fitted]` default (docs/sweeps/s12-scoring-readings.md, sweep S12)
     #[default]
     Sensed,
 }

@@ -30,7 +30,7 @@ pub enum HeadingWrap {
     /// (-pi, pi]: the default before sweep S22.
     Symmetric,
     /// [0, 2 pi): the input jumps by 2 pi where the heading crosses its
-    /// target. `[fitted]` default (docs/model.md, sweeps S21 and S22)
+    /// target. `[fitted]` default (docs/sweeps/s16-s21-s23-heading-range.md)
     #[default]
     Positive,
 }
@@ -78,7 +78,7 @@ pub struct SensorSettings {
     /// What the heading input measures. `[chosen]` error
     pub heading_input: HeadingInput,
     /// The range the heading input is wrapped to. `[fitted]` positive,
-    /// [0, 2 pi) (docs/model.md, sweeps S21 and S22)
+    /// [0, 2 pi) (docs/sweeps/s16-s21-s23-heading-range.md, S21 and S22)
     pub heading_wrap: HeadingWrap,
 }
 

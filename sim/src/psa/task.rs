@@ -115,27 +115,27 @@ pub struct Target {
 pub struct TaskSettings {
     /// Task 1: initial spin (rad/s). `[fitted]` 1.0: the paper's Table 1
     /// and 2 levels for task 1 with champions scored on the original
-    /// fitness (docs/model.md, sweeps S10 and S14)
+    /// fitness (docs/sweeps/s10-task1-spin.md, s14-s15-starts-original-scoring.md)
     pub task1_spin: f64,
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
     /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
     /// turning when the trial starts. `[fitted]` -1.5, clockwise, away from
     /// the target: the whole distance to the paper (Table 1 and 2 for task
-    /// 2 with their spreads, the burst totals and their ratio; docs/model.md,
-    /// sweeps S24 and S33-S35)
+    /// 2 with their spreads, the burst totals and their ratio;
+    /// docs/sweeps/s24-s33-s35-task2-start.md)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
     /// Task 3: initial forward (+y) speed (m/s). `[fitted]` 0.4: the paper's
-    /// Table 1 and 2 levels for task 3 (docs/model.md, sweep S17)
+    /// Table 1 and 2 levels for task 3 (docs/sweeps/s17-task3-speed.md)
     pub task3_speed: f64,
     /// Task 3: distance of the target along +y (m). `[fitted]` 0.40, the
     /// middle of the random starts' range: both ends fit Tables 1 and 2 worse
-    /// (docs/model.md, sweep S20)
+    /// (docs/sweeps/s20-task3-distance.md)
     pub task3_distance: f64,
     /// Task 3: target heading (rad). `[fitted]` 0, the start heading: the
-    /// PSA turns round to brake and back again (docs/model.md)
+    /// PSA turns round to brake and back again (docs/sweeps/s02-s06-task3-target-heading.md)
     pub task3_target_heading: f64,
     /// Task 3, random initialisation: target distance range (m). `[paper]` [0.25, 0.55]
     pub task3_random_distance: [f64; 2],
