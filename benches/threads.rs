@@ -8,8 +8,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use esp_neuroevolution::evaluate_all;
-use psa_esp::cli::bench::{machine, EvaluationPath};
+use psa_esp::cli::bench::machine;
 use psa_esp::cli::bench_networks::random_networks;
+use psa_esp::cli::bench_paths::EvaluationPath;
 use psa_esp::cli::bench_runs::{evolve_workload, replicate_workload};
 use psa_sim::ode::thread_pool;
 

@@ -173,7 +173,7 @@ fn the_most_violent_body_the_ranges_allow_never_reaches_the_guard() {
         heading: 0.0,
     })
     .unwrap();
-    for _ in 0..psa_sim::psa::limits::MAX_STEPS {
+    for _ in 0..psa_sim::psa::settings::limits::MAX_STEPS {
         b.step(&[1.0, 1.0, 0.0, 0.0]).unwrap();
     }
     assert!(b.state().omega > 1e14, "it did spin up: {:?}", b.state());
@@ -182,7 +182,7 @@ fn the_most_violent_body_the_ranges_allow_never_reaches_the_guard() {
 #[test]
 fn every_range_of_the_limits_table_is_enforced_from_a_configuration() {
     use psa_experiment::RunConfig;
-    use psa_sim::psa::limits::LIMITS;
+    use psa_sim::psa::settings::limits::LIMITS;
     let defaults = toml::Table::try_from(RunConfig::default()).unwrap();
     let problem = defaults["problem"].as_table().unwrap();
     let mut checked = 0;

@@ -16,6 +16,7 @@ use psa_sim::numeric::{Exponential, SimdLevel};
 use psa_sim::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
 use psa_sim::psa::cuda::{evaluate_with, fly_on_host};
 use psa_sim::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
+use strum::VariantArray;
 
 /// Fitness of networks `seeds` by the scalar path and by the batched path on `level`.
 fn both_paths(
@@ -38,7 +39,7 @@ fn both_paths(
 #[test]
 fn batched_fitness_equals_the_scalar_path_on_thousands_of_random_networks() {
     let settings = native(PsaSettings::default());
-    for task in Task::ALL {
+    for &task in Task::VARIANTS {
         let (scalar, batched) = both_paths(&settings, task, 0..1200, SimdLevel::detect());
         assert_bit_identical(&scalar, &batched, &format!("task {task}"));
         // The sample is not degenerate: fitness values spread out.
@@ -69,7 +70,7 @@ fn batched_fitness_equals_the_scalar_path_with_noise_random_starts_trials_and_th
 #[test]
 fn batched_fitness_equals_the_scalar_path_under_every_reading_of_the_inputs_and_fitness() {
     for (what, settings) in kernel_cases::reading_settings() {
-        for task in Task::ALL {
+        for &task in Task::VARIANTS {
             let settings = PsaSettings {
                 random_init: settings.random_init && task.has_random_init(),
                 ..settings.clone()
@@ -131,7 +132,7 @@ fn both_paths_fly_the_exponential_the_settings_name() {
         evaluate_with(settings, task, &refs[..], 0..refs.len(), &mut rngs(), fly_on_host).unwrap()
     };
     let mut moved = 0;
-    for task in Task::ALL {
+    for &task in Task::VARIANTS {
         let (fast_scalar, accurate_scalar) = (scalar(&fast, task), scalar(&accurate, task));
         for (settings, reference, what) in [(&fast, &fast_scalar, "fast"), (&accurate, &accurate_scalar, "accurate")] {
             assert_bit_identical(reference, &batched(settings, task), &format!("{what}, batched"));
@@ -152,7 +153,7 @@ fn every_simd_level_computes_the_same_bits_the_portable_fallback_included() {
     // on an AVX-512 machine it compares all three instruction sets.
     let settings = native(PsaSettings::default());
     let (scalar, _) = both_paths(&settings, Task::StopAtPosition, 100..400, SimdLevel::Portable);
-    for level in SimdLevel::ALL {
+    for &level in SimdLevel::VARIANTS {
         let (_, batched) = both_paths(&settings, Task::StopAtPosition, 100..400, level);
         assert_bit_identical(&scalar, &batched, &format!("level {level}"));
     }
@@ -170,7 +171,7 @@ fn blocks_of_every_width_and_ranges_of_a_set_give_the_same_fitness_as_a_full_blo
         .evaluate(&refs[..], 0..refs.len(), &mut streams(0..count))
         .unwrap();
     let bits = |f: &[f64]| f.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-    for level in SimdLevel::ALL {
+    for &level in SimdLevel::VARIANTS {
         let runner = runner.clone().with_level(level);
         for (i, network) in networks.iter().enumerate() {
             // Alone, a network flies in a padded small block.
@@ -211,7 +212,7 @@ fn a_networks_trials_flown_side_by_side_are_the_scalar_trials_bit_for_bit_on_eve
         (noisy_settings(), Task::StopAtPosition),
         (original_fitness_settings(), Task::StopRotation),
     ];
-    let mut paths: Vec<EvalPath> = SimdLevel::ALL.into_iter().map(EvalPath::Simd).collect();
+    let mut paths: Vec<EvalPath> = SimdLevel::VARIANTS.iter().copied().map(EvalPath::Simd).collect();
     paths.extend([EvalPath::Fastest, EvalPath::Scalar, EvalPath::KernelOnHost]);
     for (settings, task) in cases {
         for trials in [1, SMALL_LANES + 1, NARROW_LANES + 3, 2 * LANES + 5] {

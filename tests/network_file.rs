@@ -63,9 +63,9 @@ fn valid_json() -> serde_json::Value {
 }
 
 /// Makes `file` one of the build before commit `changed` (a file lacking
-/// a setting gets the value of the build that wrote it: `psa::defaults`).
+/// a setting gets the value of the build that wrote it: `psa::settings::defaults`).
 fn as_written_before(file: &mut serde_json::Value, changed: &str) {
-    let line = psa_sim::psa::defaults::BUILDS
+    let line = psa_sim::psa::settings::defaults::BUILDS
         .lines()
         .find(|l| l.starts_with(changed))
         .unwrap();

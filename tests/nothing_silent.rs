@@ -15,7 +15,7 @@ use psa_experiment::grid::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_
 use psa_experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
 use psa_experiment::RunFiles;
 use psa_sim::physics::{BackendKind, StartQuaternion};
-use psa_sim::psa::defaults::{value_at, Placement, BUILDS, CHANGES};
+use psa_sim::psa::settings::defaults::{value_at, Placement, BUILDS, CHANGES};
 use psa_sim::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};
 
 use common::psa_esp;
@@ -387,7 +387,7 @@ fn a_task_2_champion_of_the_model_before_the_refit_replays_to_its_recorded_fitne
     let dir = tempfile::tempdir().unwrap();
     let (recorded, mut old) = champion_of(dir.path(), "run", "configs/positive-heading.toml", "2");
     assert_eq!(old["problem"]["tasks"]["task2_spin"], 0.75, "the model's own start");
-    old["provenance"]["defaults"] = (psa_sim::psa::defaults::rows() - POSITIVE_HEADING_ROWS).into();
+    old["provenance"]["defaults"] = (psa_sim::psa::settings::defaults::rows() - POSITIVE_HEADING_ROWS).into();
     let replayed = replayed(dir.path(), "old", &old);
     assert_eq!(replayed.to_bits(), recorded.to_bits(), "{replayed} against {recorded}");
 }

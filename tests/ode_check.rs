@@ -161,7 +161,7 @@ fn a_champion_that_parted_the_backends_on_a_random_start_flies_alike_on_both() {
         ode.to_bits()
     );
     // On the model its file records (its build's raw start, from the table
-    // of defaults in sim/src/psa/defaults.rs) it parts as it did; ODE
+    // of defaults in sim/src/psa/settings/defaults.rs) it parts as it did; ODE
     // normalises either way.
     let earlier = random_start_fitness(&network, "native", &[]);
     assert_ne!(

@@ -13,6 +13,7 @@ use psa_sim::physics::{
 };
 use psa_sim::psa::ode_lockstep::ODE_LOCKSTEP;
 use psa_sim::psa::{BodySettings, NoiseSettings, OdeLockstepRunner, PsaSettings, Task, TrialRunner};
+use strum::VariantArray;
 
 fn bits(values: &[f64]) -> Vec<u64> {
     values.iter().map(|v| v.to_bits()).collect()
@@ -73,7 +74,7 @@ fn assert_same(settings: &PsaSettings, task: Task, seeds: std::ops::Range<u64>, 
 #[test]
 fn lockstep_fitness_equals_one_world_per_network_on_every_task() {
     let settings = PsaSettings::default();
-    for task in Task::ALL {
+    for &task in Task::VARIANTS {
         assert_same(&settings, task, 0..100, ODE_LOCKSTEP, &format!("task {task}"));
     }
 }
@@ -105,7 +106,7 @@ fn lockstep_fitness_equals_one_world_per_network_with_noise_random_starts_and_tr
 #[test]
 fn lockstep_fitness_equals_one_world_per_network_under_every_reading_of_the_inputs_and_fitness() {
     for (what, settings) in kernel_cases::reading_settings() {
-        for task in Task::ALL {
+        for &task in Task::VARIANTS {
             let settings = PsaSettings {
                 backend: psa_sim::physics::BackendKind::Ode,
                 random_init: settings.random_init && task.has_random_init(),

@@ -8,7 +8,9 @@ use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use esp_neuroevolution::{BurstMode, Credit, EspSettings, HillClimbSettings, Sampling, TopologyMode, MAX_GENERATIONS};
+use psa_sim::named::Named;
 use psa_sim::psa::PsaSettings;
+use strum::VariantArray;
 
 /// Which search algorithm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -76,8 +78,22 @@ impl RunConfig {
 pub const BASELINE: GridConfig = GridConfig::Preset(Preset::Baseline);
 
 /// One configuration of the paper.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "kebab-case")]
+#[strum(serialize_all = "kebab-case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum Preset {
     /// ESP with burst mutation discarding all sub-populations (Table 1).
     Baseline,
@@ -96,27 +112,16 @@ pub enum Preset {
 }
 
 impl Preset {
-    /// Every preset, in the paper's order.
-    pub const ALL: [Preset; 7] = [
-        Preset::Baseline,
-        Preset::Systematic,
-        Preset::MaxCredit,
-        Preset::LesionOff,
-        Preset::EraseBest,
-        Preset::HillClimb,
-        Preset::Gomez,
-    ];
-
-    /// The preset's name on the command line.
-    pub fn name(self) -> &'static str {
+    /// Whether the paper ran it: all but `gomez`.
+    pub fn in_paper(self) -> bool {
         match self {
-            Preset::Baseline => "baseline",
-            Preset::Systematic => "systematic",
-            Preset::MaxCredit => "max-credit",
-            Preset::LesionOff => "lesion-off",
-            Preset::EraseBest => "erase-best",
-            Preset::HillClimb => "hill-climb",
-            Preset::Gomez => "gomez",
+            Preset::Baseline
+            | Preset::Systematic
+            | Preset::MaxCredit
+            | Preset::LesionOff
+            | Preset::EraseBest
+            | Preset::HillClimb => true,
+            Preset::Gomez => false,
         }
     }
 
@@ -140,25 +145,8 @@ impl Preset {
     }
 }
 
-impl fmt::Display for Preset {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Preset {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Preset, String> {
-        by_name(s, &Preset::ALL, Preset::name, "preset")
-    }
-}
-
-/// The item of `all` called `s`, or an error listing the names.
-fn by_name<T: Copy>(s: &str, all: &[T], name: fn(T) -> &'static str, what: &str) -> Result<T, String> {
-    all.iter().copied().find(|&item| name(item) == s).ok_or_else(|| {
-        let names: Vec<&str> = all.iter().map(|&item| name(item)).collect();
-        format!("unknown {what} {s:?} (expected one of {})", names.join(", "))
-    })
+impl Named for Preset {
+    const WHAT: &'static str = "preset";
 }
 
 /// Overlays `overrides` onto `base`, table by table.
@@ -232,7 +220,10 @@ impl RunConfig {
 /// One configuration of the replication grid: a preset of the paper's
 /// Tables 1 and 4-7 (and Gomez's ESP), or one of Table 3's two, evolved
 /// under input noise or random initialisation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+/// [`GridConfigKind`] lists its variants, so that a new one must be placed
+/// in [`GridConfig::all`] to compile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, strum::EnumDiscriminants)]
+#[strum_discriminants(name(GridConfigKind), derive(strum::VariantArray))]
 #[serde(try_from = "String", into = "String")]
 pub enum GridConfig {
     /// A preset.
@@ -249,23 +240,26 @@ pub const PAPER_NOISE_SD: f64 = 0.05;
 pub const PAPER_NOISY_TRIALS: usize = 3;
 
 impl GridConfig {
-    /// Every configuration of the grid, in report order.
-    pub const ALL: [GridConfig; 9] = [
-        GridConfig::Preset(Preset::Baseline),
-        GridConfig::Preset(Preset::Systematic),
-        GridConfig::Preset(Preset::MaxCredit),
-        GridConfig::Preset(Preset::LesionOff),
-        GridConfig::Preset(Preset::EraseBest),
-        GridConfig::Preset(Preset::HillClimb),
-        GridConfig::Preset(Preset::Gomez),
-        GridConfig::InputNoise,
-        GridConfig::RandomInit,
-    ];
+    /// Every configuration of the grid, in report order: every preset,
+    /// then Table 3's two.
+    pub fn all() -> Vec<GridConfig> {
+        GridConfigKind::VARIANTS
+            .iter()
+            .flat_map(|kind| match kind {
+                GridConfigKind::Preset => Preset::VARIANTS.iter().map(|&p| GridConfig::Preset(p)).collect(),
+                GridConfigKind::InputNoise => vec![GridConfig::InputNoise],
+                GridConfigKind::RandomInit => vec![GridConfig::RandomInit],
+            })
+            .collect()
+    }
 
     /// Whether the paper ran it: all but `gomez`. The paper's configurations
     /// are a grid's default; `gomez` joins when named.
     pub fn in_paper(self) -> bool {
-        self != GridConfig::Preset(Preset::Gomez)
+        match self {
+            GridConfig::Preset(p) => p.in_paper(),
+            GridConfig::InputNoise | GridConfig::RandomInit => true,
+        }
     }
 
     /// The configuration's name (folder and command-line name).
@@ -317,7 +311,10 @@ impl fmt::Display for GridConfig {
 impl FromStr for GridConfig {
     type Err = String;
     fn from_str(s: &str) -> Result<GridConfig, String> {
-        by_name(s, &GridConfig::ALL, GridConfig::name, "configuration")
+        GridConfig::all().into_iter().find(|c| c.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = GridConfig::all().into_iter().map(GridConfig::name).collect();
+            format!("unknown configuration {s:?} (expected one of {})", names.join(", "))
+        })
     }
 }
 
@@ -331,5 +328,67 @@ impl TryFrom<String> for GridConfig {
 impl From<GridConfig> for String {
     fn from(c: GridConfig) -> String {
         c.name().to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::sweep::SweepMode;
+    use crate::grid::GridPreset;
+    use crate::report::{Part, ReportFormat};
+
+    /// The names of earlier builds, which folders, `grid.json`,
+    /// `sweep.json`, reports and command lines hold: a new variant adds its
+    /// name, none changes, so old results read as before.
+    #[test]
+    fn the_names_are_those_of_earlier_builds() {
+        let grid: Vec<&str> = GridConfig::all().into_iter().map(GridConfig::name).collect();
+        assert_eq!(
+            grid,
+            [
+                "baseline",
+                "systematic",
+                "max-credit",
+                "lesion-off",
+                "erase-best",
+                "hill-climb",
+                "gomez",
+                "input-noise",
+                "random-init"
+            ]
+        );
+        assert_eq!(Preset::names(), grid[..7]);
+        assert_eq!(GridPreset::names(), ["quick", "paper"]);
+        assert_eq!(SweepMode::names(), ["combinations", "one-at-a-time"]);
+        assert_eq!(ReportFormat::names(), ["md", "csv", "json"]);
+        assert_eq!(Part::names(), ["means", "spreads", "burst ratio"]);
+    }
+
+    #[test]
+    fn every_name_reads_back_and_an_unknown_one_is_named() {
+        for config in GridConfig::all() {
+            assert_eq!(config.name().parse::<GridConfig>(), Ok(config));
+            assert_eq!(serde_json::to_string(&config).unwrap(), format!("\"{config}\""));
+        }
+        for &preset in Preset::VARIANTS {
+            assert_eq!(preset.to_string().parse::<Preset>(), Ok(preset));
+            assert_eq!(serde_json::to_string(&preset).unwrap(), format!("\"{preset}\""));
+        }
+        assert!("gomes"
+            .parse::<GridConfig>()
+            .unwrap_err()
+            .contains("expected one of baseline,"));
+        assert_eq!(
+            "best".parse::<Preset>(),
+            Err("unknown preset \"best\" (expected one of baseline, systematic, max-credit, lesion-off, erase-best, hill-climb, gomez)".to_string())
+        );
+    }
+
+    /// The paper's configurations are a grid's default: all but `gomez`.
+    #[test]
+    fn the_paper_ran_all_configurations_but_gomez() {
+        let not_in_paper: Vec<GridConfig> = GridConfig::all().into_iter().filter(|c| !c.in_paper()).collect();
+        assert_eq!(not_in_paper, [GridConfig::Preset(Preset::Gomez)]);
     }
 }

@@ -23,7 +23,8 @@ pub mod results;
 mod run;
 
 pub use config::{
-    paper_esp_settings, Algorithm, GridConfig, Preset, RunConfig, BASELINE, PAPER_NOISE_SD, PAPER_NOISY_TRIALS,
+    paper_esp_settings, Algorithm, GridConfig, GridConfigKind, Preset, RunConfig, BASELINE, PAPER_NOISE_SD,
+    PAPER_NOISY_TRIALS,
 };
 pub use report::{write_report, ReportFormat, ReportOutcome};
 pub use results::EvolveOutcome;
@@ -37,7 +38,7 @@ pub fn build_info() -> psa_sim::provenance::BuildInfo {
         tool_version: env!("CARGO_PKG_VERSION").into(),
         git_commit: env!("PSA_ESP_GIT_COMMIT").into(),
         libode_version: psa_sim::ode::libode_version().into(),
-        defaults: Some(psa_sim::psa::defaults::rows() as u64),
+        defaults: Some(psa_sim::psa::settings::defaults::rows() as u64),
     }
 }
 

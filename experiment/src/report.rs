@@ -28,6 +28,7 @@ use crate::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
 use crate::results::runs_table::{runs_csv, RUNS_CSV};
 use crate::results::{load_run, GenerationRow, RunData};
 use crate::GridConfig;
+use psa_sim::named::Named;
 use psa_sim::psa::Task;
 
 pub use distance::{Distance, Part, Term};
@@ -40,8 +41,20 @@ pub use sweep::{write_sweep_report, SweepReport};
 pub use tables::{BurstRow, FigureLink, MissingCell, Report, Row, Table};
 
 /// Which files `psa-esp report` writes besides `report.md`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum ReportFormat {
     /// `report.md` only (the Markdown is also printed).
     Md,
@@ -51,18 +64,8 @@ pub enum ReportFormat {
     Json,
 }
 
-impl ReportFormat {
-    /// Every format.
-    pub const ALL: [ReportFormat; 3] = [ReportFormat::Md, ReportFormat::Csv, ReportFormat::Json];
-
-    /// The format's name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            ReportFormat::Md => "md",
-            ReportFormat::Csv => "csv",
-            ReportFormat::Json => "json",
-        }
-    }
+impl Named for ReportFormat {
+    const WHAT: &'static str = "report format";
 }
 
 /// What a table row measures, per champion.

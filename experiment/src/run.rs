@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use esp_neuroevolution::{Esp, GenerationRecord, HillClimb, LesionOutcome, RunResult};
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
 use psa_sim::io::write_atomic;
+use psa_sim::named::Named;
 use psa_sim::psa::{NetworkFile, Task};
 
 /// The files of a run directory.

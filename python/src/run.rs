@@ -9,6 +9,7 @@ use esp_neuroevolution::{AnyRun, AskPurpose, AskTell, Esp, GenerationRecord, Hil
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray};
 use psa_experiment::{Algorithm, RunConfig, RunStart};
 use psa_sim::evaluator::PsaEvaluator;
+use psa_sim::named::Named;
 use psa_sim::psa::NetworkFile;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;

@@ -5,6 +5,9 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
+use strum::VariantArray;
+
+use crate::named::Named;
 use crate::numeric::SimdLevel;
 use crate::physics::BackendKind;
 use crate::psa::batch::LANES;
@@ -21,7 +24,10 @@ pub const CUDA_BATCH: usize = 1 << 20;
 
 /// How a [`PsaEvaluator`] flies its trials, named by its caller. Every path
 /// gives the same results, bit for bit: the choice changes speed only.
-#[derive(Debug, Clone, Default)]
+/// [`EvalPathKind`] lists its variants, so that a new one must be given
+/// its names ([`EvalPath::readable`]) to compile.
+#[derive(Debug, Clone, Default, strum::EnumDiscriminants)]
+#[strum_discriminants(name(EvalPathKind), derive(strum::VariantArray))]
 pub enum EvalPath {
     /// The fastest path of the backend: on `native` the batched path at the
     /// processor's best SIMD level, on `ode` the lockstep path where the
@@ -41,41 +47,44 @@ pub enum EvalPath {
     Kernel(Arc<dyn TrialFlier>),
 }
 
-/// The names of the paths that need no device, fixed before and after the
-/// SIMD levels in [`EvalPath::NAMES`].
-const NAMES_BEFORE_LEVELS: [&str; 2] = ["fastest", "scalar"];
-/// See [`NAMES_BEFORE_LEVELS`].
-const NAMES_AFTER_LEVELS: [&str; 2] = ["ode-lockstep", "kernel-host"];
-
 impl EvalPath {
-    /// The names `EvalPath` is read from (its `FromStr`): every path but
-    /// [`EvalPath::Kernel`], which needs a device; a SIMD level by its
-    /// name, one for each of [`SimdLevel::ALL`].
-    pub const NAMES: [&'static str; NAMES_BEFORE_LEVELS.len() + SimdLevel::ALL.len() + NAMES_AFTER_LEVELS.len()] = {
-        let mut names = [""; NAMES_BEFORE_LEVELS.len() + SimdLevel::ALL.len() + NAMES_AFTER_LEVELS.len()];
-        let mut i = 0;
-        while i < names.len() {
-            names[i] = if i < NAMES_BEFORE_LEVELS.len() {
-                NAMES_BEFORE_LEVELS[i]
-            } else if i < NAMES_BEFORE_LEVELS.len() + SimdLevel::ALL.len() {
-                SimdLevel::ALL[i - NAMES_BEFORE_LEVELS.len()].name()
-            } else {
-                NAMES_AFTER_LEVELS[i - NAMES_BEFORE_LEVELS.len() - SimdLevel::ALL.len()]
-            };
-            i += 1;
+    /// The paths of `kind` that can be read by name: every SIMD level of
+    /// the batched path, none of [`EvalPath::Kernel`], which needs a device.
+    pub fn readable(kind: EvalPathKind) -> Vec<EvalPath> {
+        match kind {
+            EvalPathKind::Fastest => vec![EvalPath::Fastest],
+            EvalPathKind::Scalar => vec![EvalPath::Scalar],
+            EvalPathKind::Simd => SimdLevel::VARIANTS.iter().map(|&level| EvalPath::Simd(level)).collect(),
+            EvalPathKind::OdeLockstep => vec![EvalPath::OdeLockstep],
+            EvalPathKind::KernelOnHost => vec![EvalPath::KernelOnHost],
+            EvalPathKind::Kernel => Vec::new(),
         }
-        names
-    };
+    }
 
-    /// The path's name, as [`EvalPath::NAMES`] spells it (`"kernel"` for
+    /// Every path that can be read by name ([`EvalPath::readable`]), in
+    /// the order of the variants.
+    pub fn all_readable() -> Vec<EvalPath> {
+        EvalPathKind::VARIANTS
+            .iter()
+            .flat_map(|&kind| EvalPath::readable(kind))
+            .collect()
+    }
+
+    /// The names `EvalPath` is read from (its `FromStr`): those of
+    /// [`EvalPath::all_readable`]; a SIMD level by its name.
+    pub fn names() -> Vec<&'static str> {
+        EvalPath::all_readable().iter().map(EvalPath::name).collect()
+    }
+
+    /// The path's name, as [`EvalPath::names`] spells it (`"kernel"` for
     /// [`EvalPath::Kernel`], which has none to be read from).
     pub fn name(&self) -> &'static str {
         match self {
-            EvalPath::Fastest => NAMES_BEFORE_LEVELS[0],
-            EvalPath::Scalar => NAMES_BEFORE_LEVELS[1],
+            EvalPath::Fastest => "fastest",
+            EvalPath::Scalar => "scalar",
             EvalPath::Simd(level) => level.name(),
-            EvalPath::OdeLockstep => NAMES_AFTER_LEVELS[0],
-            EvalPath::KernelOnHost => NAMES_AFTER_LEVELS[1],
+            EvalPath::OdeLockstep => "ode-lockstep",
+            EvalPath::KernelOnHost => "kernel-host",
             EvalPath::Kernel(_) => "kernel",
         }
     }
@@ -93,22 +102,15 @@ impl EvalPath {
 impl std::str::FromStr for EvalPath {
     type Err = String;
     fn from_str(name: &str) -> Result<EvalPath, String> {
-        let unknown = || {
-            format!(
-                "unknown evaluation path {name:?} (expected one of {})",
-                EvalPath::NAMES.join(", ")
-            )
-        };
-        let fixed = [
-            EvalPath::Fastest,
-            EvalPath::Scalar,
-            EvalPath::OdeLockstep,
-            EvalPath::KernelOnHost,
-        ];
-        match fixed.into_iter().find(|path| path.name() == name) {
-            Some(path) => Ok(path),
-            None => name.parse().map(EvalPath::Simd).map_err(|_| unknown()),
-        }
+        EvalPath::all_readable()
+            .into_iter()
+            .find(|path| path.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "unknown evaluation path {name:?} (expected one of {})",
+                    EvalPath::names().join(", ")
+                )
+            })
     }
 }
 
@@ -370,20 +372,24 @@ mod tests {
 
     #[test]
     fn every_name_reads_back_as_the_path_of_that_name() {
-        for name in EvalPath::NAMES {
+        // The names of earlier builds, which command lines and scripts
+        // spell: a new path adds its name, none changes.
+        assert_eq!(
+            EvalPath::names(),
+            [
+                "fastest",
+                "scalar",
+                "portable",
+                "avx2",
+                "avx512",
+                "ode-lockstep",
+                "kernel-host"
+            ]
+        );
+        for name in EvalPath::names() {
             let path: EvalPath = name.parse().unwrap();
             assert_eq!(path.name(), name);
         }
-        let levels: Vec<&str> = SimdLevel::ALL.iter().map(|l| l.name()).collect();
-        assert!(
-            levels.iter().all(|l| EvalPath::NAMES.contains(l)),
-            "{:?}",
-            EvalPath::NAMES
-        );
-        let mut unique = EvalPath::NAMES.to_vec();
-        unique.sort_unstable();
-        unique.dedup();
-        assert_eq!(unique.len(), EvalPath::NAMES.len());
         assert!("kernel".parse::<EvalPath>().unwrap_err().contains("kernel-host"));
     }
 }

@@ -18,7 +18,8 @@
 //! 6. [`evaluator`]: the PSA as an evaluation function, on the
 //!    [`EvalPath`] its caller names.
 //!
-//! Beside them: [`io`] (atomic writes) and [`provenance`].
+//! Beside them: [`io`] (atomic writes), [`named`] (the enumerations read
+//! by name) and [`provenance`].
 //!
 //! It may not depend on the experiment crate (`psa-experiment`), on
 //! plotting or on the command line (`plotters`, `clap`): `.ci/run` checks
@@ -26,6 +27,7 @@
 
 pub mod evaluator;
 pub mod io;
+pub mod named;
 pub mod numeric;
 pub mod ode;
 pub mod physics;

@@ -16,7 +16,7 @@ pub struct BuildInfo {
     /// The libode version `ode-sys` was built against.
     pub libode_version: String,
     /// How many rows the build's table of defaults had
-    /// ([`crate::psa::defaults`]); absent in files of builds before it.
+    /// ([`crate::psa::settings::defaults`]); absent in files of builds before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub defaults: Option<u64>,
 }

@@ -1,6 +1,7 @@
 //! The PSA control problem: fitness, tasks, sensors and noise, trials.
 
 use std::f64::consts::{FRAC_PI_2, PI};
+use strum::VariantArray;
 
 use esp_neuroevolution::network::Network;
 use esp_neuroevolution::rng::stream;
@@ -138,7 +139,7 @@ fn doing_nothing_scores_0_0_and_the_coasting_points_of_task_3() {
 #[test]
 fn firing_every_thruster_fully_scores_under_2_percent() {
     let full = constant_network(1.0);
-    for task in Task::ALL {
+    for &task in Task::VARIANTS {
         // Task 3: it shoots through the box on the target heading (4 points a step).
         let f = fitness(&PsaSettings::default(), task, &full, 1);
         assert!(f < 2.0, "task {task}: {f}");
@@ -153,7 +154,7 @@ fn ode_and_native_give_the_same_fitness_with_and_without_noise() {
         ..NoiseSettings::default()
     };
     for noise in [NoiseSettings::default(), noisy] {
-        for task in Task::ALL {
+        for &task in Task::VARIANTS {
             for k in 0..8 {
                 let net = random_network(100 + k, 5);
                 let mut s = PsaSettings {
@@ -449,13 +450,20 @@ fn each_task_setting_is_read_by_exactly_one_task_and_every_other_setting_by_all(
     assert!(fields.len() >= 8, "{fields:?}");
     for name in fields.keys() {
         let setting = format!("problem.tasks.{name}");
-        let readers: Vec<Task> = Task::ALL.into_iter().filter(|t| t.reads_setting(&setting)).collect();
+        let readers: Vec<Task> = Task::VARIANTS
+            .iter()
+            .copied()
+            .filter(|t| t.reads_setting(&setting))
+            .collect();
         assert_eq!(readers.len(), 1, "{setting} is read by {readers:?}");
         assert!(name.starts_with(&format!("task{}_", readers[0].number())), "{setting}");
     }
     assert!(!Task::StopRotation.reads_setting("problem.tasks.task2_spin"));
     assert!(Task::Turn.reads_setting("problem.tasks.task2_spin"));
     for setting in ["problem.sensors.heading_wrap", "esp.stagnation", "problem.body.density"] {
-        assert!(Task::ALL.into_iter().all(|t| t.reads_setting(setting)), "{setting}");
+        assert!(
+            Task::VARIANTS.iter().copied().all(|t| t.reads_setting(setting)),
+            "{setting}"
+        );
     }
 }

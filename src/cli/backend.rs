@@ -63,7 +63,7 @@ pub struct EvalPathArg {
     pub eval_path: EvalPath,
 }
 
-/// The parser of `--eval-path`: one of [`EvalPath::NAMES`].
+/// The parser of `--eval-path`: one of [`EvalPath::names`].
 fn eval_path_parser() -> impl TypedValueParser<Value = EvalPath> {
-    PossibleValuesParser::new(EvalPath::NAMES).map(|name| name.parse().expect("clap admits only the names"))
+    PossibleValuesParser::new(EvalPath::names()).map(|name| name.parse().expect("clap admits only the names"))
 }

@@ -16,15 +16,16 @@ use serde::Serialize;
 
 use super::bench_kernel::{kernel_rows, KernelBench, KERNEL_NETWORKS};
 use super::bench_networks::{random_networks, HIDDEN};
+use super::bench_paths::{evaluation_rate, EvaluationPath};
 use super::bench_runs::{algorithm_overhead, evolve_workload, median, replicate_workload};
-use esp_neuroevolution::evaluate_all;
+use super::choice::choice;
 use esp_neuroevolution::network::Network;
-use psa_experiment::PAPER_NOISE_SD;
-use psa_sim::evaluator::{EvalPath, PsaEvaluator};
+use psa_sim::evaluator::EvalPath;
+use psa_sim::named::Named;
 use psa_sim::numeric::{sigmoid, Lanes, SimdLevel};
 use psa_sim::physics::{create_backend, random_thrust_sequence, BackendKind, BodyState, OdeBackend, PhysicsBackend};
 use psa_sim::psa::batch::LANES;
-use psa_sim::psa::{BodySettings, PsaSettings, Task, THRUSTER_COUNT};
+use psa_sim::psa::{BodySettings, PsaSettings, THRUSTER_COUNT};
 
 /// Arguments of `bench`.
 #[derive(Debug, clap::Args)]
@@ -66,116 +67,8 @@ pub struct BenchArgs {
           conflicts_with_all = ["steps", "generations", "kernel_networks", "kernel_host", "kernel_only"])]
     pub speedup_floor: Option<f64>,
     /// The SIMD level --speedup-floor times (default: the CPU's best).
-    #[arg(long, requires = "speedup_floor", value_parser = simd_level_parser())]
+    #[arg(long, requires = "speedup_floor", value_parser = choice::<SimdLevel>())]
     pub speedup_level: Option<SimdLevel>,
-}
-
-/// The parser of `--speedup-level`: one of [`SimdLevel::ALL`]'s names.
-fn simd_level_parser() -> impl clap::builder::TypedValueParser<Value = SimdLevel> {
-    use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(SimdLevel::ALL.map(SimdLevel::name))
-        .map(|name| name.parse().expect("clap admits only the names"))
-}
-
-/// A way of evaluating networks: a backend and the [`EvalPath`] on it (on
-/// `native` the scalar reference or the batched path on one SIMD level, on
-/// `ode` one world per network or the lockstep path, many bodies in one
-/// world), with or without input noise. Written to JSON as `backend`,
-/// `simd` (the batched path's level, `null` otherwise), `ode_lockstep` and
-/// `input_noise`.
-#[derive(Debug, Clone)]
-pub struct EvaluationPath {
-    /// The physics backend.
-    pub backend: BackendKind,
-    /// The path on it: [`EvalPath::Scalar`], [`EvalPath::Simd`] or
-    /// [`EvalPath::OdeLockstep`].
-    pub path: EvalPath,
-    /// Under the paper's input noise (sd 0.05), as in its noisy configurations.
-    pub input_noise: bool,
-}
-
-impl Serialize for EvaluationPath {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        use serde::ser::SerializeStruct;
-        let simd = match self.path {
-            EvalPath::Simd(level) => Some(level),
-            _ => None,
-        };
-        let mut row = serializer.serialize_struct("EvaluationPath", 4)?;
-        row.serialize_field("backend", &self.backend)?;
-        row.serialize_field("simd", &simd)?;
-        row.serialize_field("ode_lockstep", &matches!(self.path, EvalPath::OdeLockstep))?;
-        row.serialize_field("input_noise", &self.input_noise)?;
-        row.end()
-    }
-}
-
-impl EvaluationPath {
-    /// The path's name in the bench's table.
-    pub fn label(&self) -> String {
-        let path = match (self.backend, &self.path) {
-            (BackendKind::Native, EvalPath::Simd(level)) => format!("native batched {level}"),
-            (BackendKind::Ode, EvalPath::OdeLockstep) => "ode lockstep".into(),
-            (BackendKind::Native, _) => "native scalar".into(),
-            (BackendKind::Ode, _) => "ode one world each".into(),
-            (backend, _) => backend.name().into(),
-        };
-        if self.input_noise {
-            format!("{path}, input noise")
-        } else {
-            path
-        }
-    }
-
-    /// ode one world per network and in lockstep, native scalar, native
-    /// batched on every level the CPU has, rapier; then native scalar and
-    /// batched on the CPU's best level under input noise.
-    pub fn all() -> Vec<EvaluationPath> {
-        let on = |backend, path| EvaluationPath {
-            backend,
-            path,
-            input_noise: false,
-        };
-        let mut paths = Vec::new();
-        for backend in BackendKind::available() {
-            paths.push(on(backend, EvalPath::Scalar));
-            match backend {
-                BackendKind::Ode => paths.push(on(backend, EvalPath::OdeLockstep)),
-                BackendKind::Native => paths.extend(
-                    SimdLevel::ALL
-                        .into_iter()
-                        .filter(|l| l.is_supported())
-                        .map(|level| on(backend, EvalPath::Simd(level))),
-                ),
-                BackendKind::Rapier => {}
-            }
-        }
-        let native = |p: &&EvaluationPath| p.backend == BackendKind::Native;
-        let scalar = paths.iter().find(|p| native(p) && matches!(p.path, EvalPath::Scalar));
-        let best_batched = paths.iter().rfind(|p| native(p) && matches!(p.path, EvalPath::Simd(_)));
-        let noisy: Vec<_> = [scalar, best_batched]
-            .into_iter()
-            .flatten()
-            .map(|path| EvaluationPath {
-                input_noise: true,
-                ..path.clone()
-            })
-            .collect();
-        paths.extend(noisy);
-        paths
-    }
-
-    /// The evaluator of the benchmark's task (task 1, default settings) on this path.
-    pub fn evaluator(&self) -> Result<PsaEvaluator> {
-        let mut settings = PsaSettings {
-            backend: self.backend,
-            ..PsaSettings::default()
-        };
-        if self.input_noise {
-            settings.noise.input_sd = PAPER_NOISE_SD;
-        }
-        PsaEvaluator::new(settings, Task::StopRotation, &self.path)
-    }
 }
 
 /// One path's speed at whole network evaluations (one 500-step trial each).
@@ -197,14 +90,6 @@ fn evaluations_per_second(path: &EvaluationPath, networks: &[Network], threads: 
         .map(|round| pool.install(|| evaluation_rate(&evaluator, networks, round)))
         .collect::<Result<Vec<f64>>>()?;
     Ok(median(rates))
-}
-
-/// Evaluations per second of one round of `networks` on `evaluator`, on
-/// the thread pool it is called in (the round seeds the trials).
-pub(super) fn evaluation_rate(evaluator: &PsaEvaluator, networks: &[Network], round: u64) -> Result<f64> {
-    let start = Instant::now();
-    evaluate_all(evaluator, networks, round, &[])?;
-    Ok(networks.len() as f64 / start.elapsed().as_secs_f64())
 }
 
 /// The logistic function alone, as the batched path computes it: blocks of

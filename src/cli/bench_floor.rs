@@ -6,10 +6,11 @@
 //! AVX-512 paths clear with room: CI runs it (`.ci/run`).
 
 use anyhow::{bail, Result};
+use psa_sim::named::Named;
 use serde::Serialize;
 
-use super::bench::{evaluation_rate, EvaluationPath};
 use super::bench_networks::random_networks;
+use super::bench_paths::{evaluation_rate, EvaluationPath};
 use super::bench_runs::median;
 use super::EXIT_CHECK_FAILED;
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};

@@ -1,10 +1,11 @@
 //! `psa-esp crosscheck`: every backend against ODE on random thrust sequences.
 
 use anyhow::Result;
+use psa_sim::named::Named;
 
 use super::{PhysicsArgs, EXIT_CHECK_FAILED};
 use psa_sim::physics::crosscheck;
-use psa_sim::psa::limits::MAX_STEPS;
+use psa_sim::psa::settings::limits::MAX_STEPS;
 use psa_sim::psa::BodySettings;
 
 /// The most random thrust sequences of one cross-check (only time grows with them).

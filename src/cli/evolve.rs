@@ -8,6 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::backend::{BackendArg, EvalPathArg};
 use super::choice::choice;
 use psa_experiment::{run_evolution, Preset};
+use psa_sim::named::Named;
 use psa_sim::ode::MAX_THREADS;
 use psa_sim::psa::Task;
 
@@ -18,7 +19,7 @@ pub struct EvolveArgs {
     #[arg(long)]
     pub task: Task,
     /// The paper's configuration to start from.
-    #[arg(long, value_parser = choice(&Preset::ALL, Preset::name), default_value_t = Preset::Baseline)]
+    #[arg(long, value_parser = choice::<Preset>(), default_value_t = Preset::Baseline)]
     pub preset: Preset,
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]

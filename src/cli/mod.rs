@@ -14,6 +14,7 @@ pub mod bench_floor;
 pub mod bench_kernel;
 pub mod bench_networks;
 pub mod bench_ode;
+pub mod bench_paths;
 pub mod bench_runs;
 mod choice;
 mod crosscheck;
@@ -95,10 +96,10 @@ pub struct PhysicsArgs {
 
 impl PhysicsArgs {
     /// The step settings these options describe; `--dt` must be in the
-    /// range of `physics.dt` ([`psa_sim::psa::limits`]).
+    /// range of `physics.dt` ([`psa_sim::psa::settings::limits`]).
     pub fn settings(&self) -> anyhow::Result<psa_sim::physics::StepSettings> {
         use psa_sim::physics::{PlaneConstraint, StepSettings, Stepper};
-        psa_sim::psa::limits::check_as("physics.dt", "--dt", self.dt).map_err(anyhow::Error::msg)?;
+        psa_sim::psa::settings::limits::check_as("physics.dt", "--dt", self.dt).map_err(anyhow::Error::msg)?;
         let settings = StepSettings {
             dt: self.dt,
             stepper: if self.stepper == "quick" {

@@ -9,7 +9,7 @@ use super::choice::choice;
 use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::plots::{write_trial_pictures, TrialPicture};
 use psa_sim::physics::BackendKind;
-use psa_sim::psa::limits::{check_as, MAX_TRIALS};
+use psa_sim::psa::settings::limits::{check_as, MAX_TRIALS};
 use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRecord, TrialRunner};
 
 /// Key of the random stream of replays.
@@ -24,7 +24,7 @@ pub struct ReplayArgs {
     #[arg(long)]
     pub task: Option<Task>,
     /// Physics backend.
-    #[arg(long, value_parser = choice(&BackendKind::ALL, BackendKind::name), default_value_t = BackendKind::Ode)]
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Standard deviation of Gaussian noise on every input but the bias.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]

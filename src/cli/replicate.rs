@@ -20,7 +20,7 @@ use psa_experiment::GridConfig;
 use psa_sim::evaluator::EvalPath;
 use psa_sim::ode::MAX_THREADS;
 use psa_sim::physics::BackendKind;
-use psa_sim::psa::limits::MAX_TRIALS;
+use psa_sim::psa::settings::limits::MAX_TRIALS;
 use psa_sim::psa::Task;
 
 /// Arguments of `replicate`.
@@ -40,7 +40,7 @@ pub struct GridArgs {
     /// quick: a reduced grid (5 seeds, 80 generations, 100-trial robustness,
     /// native backend; about a minute on 2 cores); paper: the full protocol
     /// (30 seeds, 2000 generations, 500-trial robustness, native backend).
-    #[arg(long, value_parser = choice(&GridPreset::ALL, GridPreset::name), default_value = GridPreset::Quick.name())]
+    #[arg(long, value_parser = choice::<GridPreset>(), default_value_t = GridPreset::Quick)]
     pub preset: GridPreset,
     /// Configurations, comma-separated (default: the paper's baseline,
     /// systematic, max-credit, lesion-off, erase-best, hill-climb,

@@ -16,7 +16,7 @@ pub struct ReportArgs {
     /// md: write report.md and print it; csv: also report.csv (one row per
     /// table cell); json: also report.json (the whole report). The figures
     /// go to DIR/figures/ in every case.
-    #[arg(long, value_parser = choice(&ReportFormat::ALL, ReportFormat::name), default_value = ReportFormat::Md.name())]
+    #[arg(long, value_parser = choice::<ReportFormat>(), default_value_t = ReportFormat::Md)]
     pub format: ReportFormat,
 }
 

@@ -9,7 +9,7 @@ use super::replicate::read_overrides;
 use psa_experiment::grid::rescore::{check_out, check_rescoring_acts, rescore, rescored_spec};
 use psa_experiment::grid::GridSpec;
 use psa_sim::ode::MAX_THREADS;
-use psa_sim::psa::limits::MAX_TRIALS;
+use psa_sim::psa::settings::limits::MAX_TRIALS;
 
 /// Arguments of `rescore`.
 #[derive(Debug, clap::Args)]

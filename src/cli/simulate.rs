@@ -8,13 +8,14 @@ use anyhow::{bail, Result};
 use super::choice::choice;
 use super::{PhysicsArgs, TRAJECTORY_HEADER};
 use psa_sim::physics::{create_backend, for_each_state, BackendKind, BodyState, PhysicsBackend};
-use psa_sim::psa::{limits, BodySettings, THRUSTER_COUNT};
+use psa_sim::psa::settings::limits;
+use psa_sim::psa::{BodySettings, THRUSTER_COUNT};
 
 /// Arguments of `simulate`.
 #[derive(Debug, clap::Args)]
 pub struct SimulateArgs {
     /// Physics backend.
-    #[arg(long, value_parser = choice(&BackendKind::ALL, BackendKind::name), default_value_t = BackendKind::Ode)]
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value_t = BackendKind::Ode)]
     pub backend: BackendKind,
     /// Constant thrust of the four thrusters, each in [0, 1]: u0,u1,u2,u3.
     #[arg(

@@ -18,7 +18,7 @@ pub struct SweepArgs {
     pub vary: Vec<String>,
     /// combinations: every combination of the values; one-at-a-time: each
     /// setting alone (the others at the base), plus the base.
-    #[arg(long, value_parser = choice(&SweepMode::ALL, SweepMode::name), default_value = SweepMode::Combinations.name())]
+    #[arg(long, value_parser = choice::<SweepMode>(), default_value_t = SweepMode::Combinations)]
     pub mode: SweepMode,
     /// The grid each variant runs.
     #[command(flatten)]

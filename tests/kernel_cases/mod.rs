@@ -7,9 +7,10 @@ use esp_neuroevolution::rng::{stream, Stream};
 use psa_sim::numeric::Exponential;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::cuda::{evaluate_with, TrialBatch, TrialPoints};
-use psa_sim::psa::readings::every_test_value;
+use psa_sim::psa::settings::readings::every_test_value;
 use psa_sim::psa::{FitnessKind, NoiseSettings, PsaError, PsaSettings, Task, TrialRunner};
 use rand::RngExt;
+use strum::VariantArray;
 
 /// A random 7-H-4 network: H in 1..=9, weights uniform in a range of scale
 /// 0.3 to 30 (from nearly linear to fully saturated units), and now and
@@ -58,7 +59,7 @@ pub fn original_fitness_settings() -> PsaSettings {
 
 /// Every reading of the inputs and the fitness at a value other than its
 /// default, together: the test value of each row of
-/// [`READINGS`](psa_sim::psa::readings::READINGS) (with the table's rows
+/// [`READINGS`](psa_sim::psa::settings::readings::READINGS) (with the table's rows
 /// today: the heading input absolute and wrapped to (-pi, pi], the signed
 /// slowing rule, the fitness read from the true state, task 3 evolved on
 /// the original fitness over 250 steps, task 1 scored on the incremental
@@ -128,7 +129,7 @@ pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Re
         )
     };
     let clean = native(PsaSettings::default());
-    for task in Task::ALL {
+    for &task in Task::VARIANTS {
         check(&clean, task, 9000..9400, &format!("clean task {task}"));
     }
     let noisy = noisy_settings();
@@ -142,7 +143,7 @@ pub fn assert_kernel_gives_the_scalar_paths_bits(fly: impl Fn(&TrialBatch) -> Re
     };
     check(&accurate, Task::StopAtPosition, 9000..9400, "accurate exponential");
     for (what, settings) in reading_settings() {
-        for task in Task::ALL {
+        for &task in Task::VARIANTS {
             let settings = PsaSettings {
                 random_init: settings.random_init && task.has_random_init(),
                 ..settings.clone()

@@ -6,7 +6,7 @@
 //! byte-identical to those of the run-by-run executor (run.json's times
 //! aside). Every `CHECKPOINT_ROUNDS` rounds or more (so that saving takes
 //! at most `CHECKPOINT_SHARE` of the time) each unfinished run saves its
-//! whole state to [`CHECKPOINT`] in its folder; a grid killed and started
+//! whole state to its [checkpoint](crate::grid::checkpoint) in its folder; a grid killed and started
 //! again resumes each run from there, to the same files.
 
 use std::path::{Path, PathBuf};
@@ -15,6 +15,7 @@ use std::sync::Mutex;
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 
+use crate::grid::checkpoint::{check_checkpoint, remove_checkpoint, resume, save_checkpoints, CHECKPOINT};
 use crate::grid::runner::{run_seed, test_and_mark, FinishedRun};
 use crate::grid::{run_dir, GridSpec, RunKey};
 use crate::{Algorithm, GridConfig, RunConfig, RunStart};
@@ -22,9 +23,6 @@ use esp_neuroevolution::together::run_together_with;
 use esp_neuroevolution::{AnyRun, AskTell, Control, Esp, HillClimb};
 use psa_sim::evaluator::{EvalPath, PsaEvaluator};
 use psa_sim::psa::Task;
-
-/// A lockstep run's saved state, in its folder while it is unfinished.
-pub const CHECKPOINT: &str = "checkpoint.json";
 
 /// Rounds between two checkpoints of the runs at least (a round is a
 /// generation, or an ESP lesion test).
@@ -141,102 +139,6 @@ pub(super) fn replicate_lockstep(
                     .and_then(|outcome| test_and_mark(dir, spec, &run.key, outcome, path)),
             );
         });
-}
-
-/// Saves every unfinished run of `runs` to its checkpoint file (of
-/// `files`), in parallel; a run that cannot be saved goes on unsaved.
-fn save_checkpoints(runs: &[AnyRun], files: &[PathBuf]) {
-    runs.par_iter().zip(files).with_max_len(1).for_each(|(run, file)| {
-        if run.ending().is_none() {
-            let saved = serde_json::to_vec(run).map_err(anyhow::Error::from).and_then(|json| {
-                // One that could not be read back is not written.
-                anyhow::ensure!(
-                    json.len() as u64 <= psa_sim::io::MAX_INPUT_BYTES,
-                    "the run's state takes {} bytes, more than the {} an input file may",
-                    json.len(),
-                    psa_sim::io::MAX_INPUT_BYTES
-                );
-                Ok(json)
-            });
-            if let Err(e) = saved.and_then(|json| psa_sim::io::write_atomic(file, &json)) {
-                log::warn!("cannot save {}: {e:#}", file.display());
-            }
-        }
-    });
-}
-
-/// Refuses a run whose checkpoint is there but not a regular file (a
-/// directory, a FIFO, a link): it could be neither read nor removed.
-pub(crate) fn check_checkpoint(folder: &Path) -> Result<()> {
-    let file = folder.join(CHECKPOINT);
-    match std::fs::symlink_metadata(&file) {
-        Ok(meta) if !meta.file_type().is_file() => anyhow::bail!(
-            "{}: it is not a regular file (a {}); remove it to run the run",
-            file.display(),
-            if meta.is_dir() {
-                "directory"
-            } else if meta.file_type().is_symlink() {
-                "symbolic link"
-            } else {
-                "FIFO, device or socket"
-            }
-        ),
-        _ => Ok(()),
-    }
-}
-
-/// Removes a finished run's checkpoint, if any.
-pub(crate) fn remove_checkpoint(folder: &Path) -> Result<()> {
-    match std::fs::remove_file(folder.join(CHECKPOINT)) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(e).with_context(|| format!("cannot remove {}", folder.join(CHECKPOINT).display()))
-        }
-        _ => Ok(()),
-    }
-}
-
-/// The run that `folder`'s checkpoint saved, when there is one of the
-/// same search as `fresh` (else `fresh`: a checkpoint that does not parse
-/// or is of another search is ignored, with a warning). A checkpoint is an
-/// input file as any other (docs/limits.md): anything but a regular file
-/// (a FIFO, a link, a directory, a device) or a file over
-/// [`psa_sim::io::MAX_INPUT_BYTES`] is refused, and the run with it, by an
-/// error naming it, before the run starts.
-fn resume(folder: &Path, fresh: AnyRun) -> Result<AnyRun> {
-    let file = folder.join(CHECKPOINT);
-    match std::fs::symlink_metadata(&file) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(fresh),
-        // Anything else but a regular file is refused by read_input_text
-        // below, naming what it is; a link is refused even when it points at
-        // a regular file.
-        Ok(meta) if meta.file_type().is_symlink() => {
-            anyhow::bail!(
-                "{}: it is a symbolic link, not a regular file; remove it to start the run afresh",
-                file.display()
-            );
-        }
-        _ => {}
-    }
-    let json = psa_sim::io::read_input_text(&file)
-        .map_err(|problem| anyhow::anyhow!("{}: {problem}; remove it to start the run afresh", file.display()))?;
-    Ok(match serde_json::from_str::<AnyRun>(&json) {
-        Ok(saved) if saved.same_search(&fresh) => {
-            log::info!(
-                "{}: resumed after generation {}",
-                folder.display(),
-                saved.records().len()
-            );
-            saved
-        }
-        Ok(_) => {
-            log::warn!("{}: of another search, ignored", file.display());
-            fresh
-        }
-        Err(e) => {
-            log::warn!("{}: cannot be read ({e}), ignored", file.display());
-            fresh
-        }
-    })
 }
 
 /// Starts run `key` of grid `grid` (of definition `spec`) in `folder` (its

@@ -17,6 +17,7 @@
 //! ([`replicate`]) and in lockstep ([`lockstep`]), [`sweep`] and
 //! [`rescore`], and for batch jobs [`shard`] and [`claim`].
 
+pub mod checkpoint;
 pub mod claim;
 pub mod lockstep;
 pub mod replicate;
@@ -26,11 +27,13 @@ pub mod shard;
 pub mod sweep;
 
 use std::path::{Path, PathBuf};
+use strum::VariantArray;
 
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::{EvolveOutcome, GridConfig, RunConfig, RunFiles};
+use psa_sim::named::Named;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::Task;
 
@@ -51,8 +54,21 @@ pub const GRID_KEYS: [(&str, &str); 3] = [
 pub const MAX_SEEDS: u64 = 10_000;
 
 /// Which protocol a grid follows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum GridPreset {
     /// A reduced grid that finishes in about a minute on 2 cores.
     Quick,
@@ -61,17 +77,8 @@ pub enum GridPreset {
     Paper,
 }
 
-impl GridPreset {
-    /// Every preset.
-    pub const ALL: [GridPreset; 2] = [GridPreset::Quick, GridPreset::Paper];
-
-    /// The preset's name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            GridPreset::Quick => "quick",
-            GridPreset::Paper => "paper",
-        }
-    }
+impl Named for GridPreset {
+    const WHAT: &'static str = "grid preset";
 }
 
 /// A grid's definition, written to `grid.json`.
@@ -147,8 +154,8 @@ impl GridSpec {
             format: GRID_FORMAT.into(),
             version: GRID_VERSION,
             preset,
-            configs: GridConfig::ALL.into_iter().filter(|c| c.in_paper()).collect(),
-            tasks: Task::ALL.into_iter().filter(|t| t.in_paper()).collect(),
+            configs: GridConfig::all().into_iter().filter(|c| c.in_paper()).collect(),
+            tasks: Task::VARIANTS.iter().copied().filter(|t| t.in_paper()).collect(),
             seeds,
             generations,
             backend,
@@ -175,7 +182,7 @@ impl GridSpec {
             bail!("the grid needs at least one configuration and one task");
         }
         let max_generations = esp_neuroevolution::MAX_GENERATIONS;
-        let max_trials = psa_sim::psa::limits::MAX_TRIALS;
+        let max_trials = psa_sim::psa::settings::limits::MAX_TRIALS;
         for (name, value, max) in [
             ("seeds", self.seeds, MAX_SEEDS),
             ("generations", self.generations as u64, max_generations as u64),
@@ -282,16 +289,16 @@ impl GridSpec {
 
     /// The configuration a run of `config` had in this grid when the build
     /// at `placement` wrote it: [`GridSpec::run_config`] with every setting
-    /// of the table of defaults (`psa::defaults`) at that build's value,
+    /// of the table of defaults (`psa::settings::defaults`) at that build's value,
     /// under the grid's overrides. An error when the build cannot be placed.
     pub fn run_config_at(
         &self,
         config: GridConfig,
-        placement: &psa_sim::psa::defaults::Placement,
+        placement: &psa_sim::psa::settings::defaults::Placement,
     ) -> Result<RunConfig> {
         let mut table = toml::Table::try_from(RunConfig::default())?;
-        for row in psa_sim::psa::defaults::CHANGES {
-            let value = psa_sim::psa::defaults::value_at(row.key, placement).map_err(anyhow::Error::msg)?;
+        for row in psa_sim::psa::settings::defaults::CHANGES {
+            let value = psa_sim::psa::settings::defaults::value_at(row.key, placement).map_err(anyhow::Error::msg)?;
             if let Some(value) = value {
                 let value: toml::Value = serde_json::from_value(value)?;
                 set_leaf(&mut table, row.key, value);
@@ -430,7 +437,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
         Judge::Read => {
             let found = run_folder_config(&folder)?;
             // The run as its own build made it: this grid under that build's
-            // defaults (`psa::defaults`); every setting must agree.
+            // defaults (`psa::settings::defaults`); every setting must agree.
             if let Ok(at_build) = spec.run_config_at(key.config, &folder_placement(&folder)) {
                 let differ = differences_read_by(key.task, &found, &at_build)?;
                 if !differ.is_empty() {
@@ -448,8 +455,12 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
                 }
             }
             // A build that cannot be placed: every setting whose default never
-            // changed (no row in `psa::defaults`) holds at any build.
-            let changed_ever = |setting: &str| psa_sim::psa::defaults::CHANGES.iter().any(|c| c.key == setting);
+            // changed (no row in `psa::settings::defaults`) holds at any build.
+            let changed_ever = |setting: &str| {
+                psa_sim::psa::settings::defaults::CHANGES
+                    .iter()
+                    .any(|c| c.key == setting)
+            };
             if let Some((setting, there, here)) = differences_read_by(key.task, &found, &expected)?
                 .into_iter()
                 .find(|(setting, _, _)| !changed_ever(setting))
@@ -495,7 +506,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
 
 /// The configuration of the run in `folder` (its `config.toml`), each
 /// setting it lacks given the value the build that wrote it used (named
-/// by its `run.json`; see `psa::defaults`).
+/// by its `run.json`; see `psa::settings::defaults`).
 pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
     let path = RunFiles::in_dir(folder).config;
     let text = psa_sim::io::read_input(&path, "run configuration")?;
@@ -503,7 +514,8 @@ pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
     let table: toml::Table = toml::from_str(&text).with_context(damaged)?;
     let mut doc = serde_json::to_value(&table).with_context(damaged)?;
     let placement = folder_placement(folder);
-    psa_sim::psa::defaults::fill(&mut doc, "", &placement).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    psa_sim::psa::settings::defaults::fill(&mut doc, "", &placement)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let table: toml::Table = serde_json::from_value(doc).with_context(damaged)?;
     RunConfig::default()
         .with_overrides(&toml::to_string(&table)?)
@@ -512,8 +524,8 @@ pub fn run_folder_config(folder: &Path) -> Result<RunConfig> {
 
 /// Where the build that wrote the run in `folder` stands in the table of
 /// defaults: by its `run.json`'s `build`.
-fn folder_placement(folder: &Path) -> psa_sim::psa::defaults::Placement {
-    use psa_sim::psa::defaults::Placement;
+fn folder_placement(folder: &Path) -> psa_sim::psa::settings::defaults::Placement {
+    use psa_sim::psa::settings::defaults::Placement;
     match EvolveOutcome::build_of(&RunFiles::in_dir(folder).summary) {
         Some(serde_json::Value::Object(build)) => Placement::of_json(Some(&build)),
         _ => Placement::Unknown("its run.json, which names its build, is not written (yet)".into()),

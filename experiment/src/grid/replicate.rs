@@ -127,7 +127,7 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Resul
             Ok(RunStatus::Finished) => {
                 // What a killed process left in a finished run.
                 crate::grid::claim::clear_stale(&folder, DEFAULT_CLAIM_TIMEOUT)?;
-                crate::grid::lockstep::remove_checkpoint(&folder)?;
+                crate::grid::checkpoint::remove_checkpoint(&folder)?;
             }
             Ok(RunStatus::Missing | RunStatus::Unfinished) => todo.push(*key),
             Err(e) => problems.push(format!("{e:#}")),

@@ -48,7 +48,7 @@ pub struct FinishedRun {
 /// evaluated on `path`.
 pub fn run_one(dir: &Path, spec: &GridSpec, key: &RunKey, path: &EvalPath) -> Result<FinishedRun> {
     let folder = run_dir(dir, key);
-    crate::grid::lockstep::check_checkpoint(&folder)?;
+    crate::grid::checkpoint::check_checkpoint(&folder)?;
     let config = spec.run_config(key.config)?;
     let seed = run_seed(key);
     let outcome = run_evolution(&config, key.config.name(), key.task, seed, &folder, path, |_| {})
@@ -87,7 +87,7 @@ pub(crate) fn test_and_mark(
     // A checkpoint an earlier lockstep process left (this run ran again
     // from the start, or resumed from it): a finished run holds only its
     // documented files.
-    crate::grid::lockstep::remove_checkpoint(&folder)?;
+    crate::grid::checkpoint::remove_checkpoint(&folder)?;
     mark_finished(&folder, &robustness)?;
     Ok(FinishedRun { key: *key, outcome })
 }

@@ -14,6 +14,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use psa_sim::named::Named;
 use serde::{Deserialize, Serialize};
 
 use crate::grid::replicate::{replicate_grids, GridJob, GridProgress, HeldRun, ReplicateOptions};
@@ -43,8 +44,21 @@ pub struct Vary {
 }
 
 /// How the varied settings combine.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "kebab-case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum SweepMode {
     /// Every combination of the values (the Cartesian product).
     Combinations,
@@ -52,17 +66,8 @@ pub enum SweepMode {
     OneAtATime,
 }
 
-impl SweepMode {
-    /// Every mode.
-    pub const ALL: [SweepMode; 2] = [SweepMode::Combinations, SweepMode::OneAtATime];
-
-    /// The mode's name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            SweepMode::Combinations => "combinations",
-            SweepMode::OneAtATime => "one-at-a-time",
-        }
-    }
+impl Named for SweepMode {
+    const WHAT: &'static str = "sweep mode";
 }
 
 /// One variant: its name (its folder) and its settings.

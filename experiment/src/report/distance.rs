@@ -24,35 +24,30 @@ use super::{GridResults, Metric};
 use crate::results::stats::mean_sd;
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
+use psa_sim::named::Named;
 use psa_sim::psa::Task;
 
 /// Max credit, the paper's second burst total.
 const MAX_CREDIT: GridConfig = GridConfig::Preset(Preset::MaxCredit);
 
-/// Which part of the distance a term belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+/// Which part of the distance a term belongs to; reports print the parts
+/// in this order, by their names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, strum::VariantArray, strum::IntoStaticStr)]
 #[serde(rename_all = "snake_case")]
 pub enum Part {
     /// Table 1's and Table 2's means and the burst totals.
+    #[strum(serialize = "means")]
     Mean,
     /// Table 1's and Table 2's standard deviations.
+    #[strum(serialize = "spreads")]
     Spread,
     /// Max credit's bursts over the baseline's.
+    #[strum(serialize = "burst ratio")]
     BurstRatio,
 }
 
-impl Part {
-    /// Every part, in the order reports print them.
-    pub const ALL: [Part; 3] = [Part::Mean, Part::Spread, Part::BurstRatio];
-
-    /// The part's name in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            Part::Mean => "means",
-            Part::Spread => "spreads",
-            Part::BurstRatio => "burst ratio",
-        }
-    }
+impl Named for Part {
+    const WHAT: &'static str = "part";
 }
 
 /// One term of the distance.

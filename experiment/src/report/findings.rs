@@ -10,6 +10,7 @@ use super::{GridResults, Metric};
 use crate::results::stats::{mean_sd, welch};
 use crate::BASELINE;
 use crate::{GridConfig, Preset};
+use psa_sim::named::Named;
 use psa_sim::psa::Task;
 
 /// Significance level of the Welch rules.

@@ -157,10 +157,11 @@ pub fn paper_bursts_per_run(config: GridConfig) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use strum::VariantArray;
 
     #[test]
     fn the_papers_tasks_are_those_the_task_says_are_in_the_paper() {
-        let in_paper: Vec<Task> = Task::ALL.into_iter().filter(|t| t.in_paper()).collect();
+        let in_paper: Vec<Task> = Task::VARIANTS.iter().copied().filter(|t| t.in_paper()).collect();
         assert_eq!(in_paper, PAPER_TASKS);
         assert_eq!(PAPER_BURST_RUNS, PAPER_RUNS_ALL);
     }

@@ -8,6 +8,7 @@ use super::paper::PAPER_BURST_RUNS;
 use super::tables::{Report, Table};
 use crate::grid::{GridPreset, GridSpec};
 use crate::PAPER_NOISE_SD;
+use psa_sim::named::Named;
 
 /// A mean or sd with one decimal; "–" when undefined.
 pub(super) fn num(x: f64) -> String {

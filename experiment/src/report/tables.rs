@@ -3,6 +3,7 @@
 
 use super::distance::Distance;
 use std::collections::BTreeMap;
+use strum::VariantArray;
 
 use serde::Serialize;
 
@@ -169,6 +170,14 @@ const CHAMPION_TABLES: [(&str, &str, &[GridConfig]); 6] = [
     ),
 ];
 
+/// Table 3's configurations, each with the test its champions are
+/// compared with the baseline's on. Every other configuration has its
+/// table in [`CHAMPION_TABLES`] (a test checks that each has one).
+const TABLE3_CONFIGS: [(GridConfig, Metric); 2] = [
+    (GridConfig::InputNoise, Metric::InputNoise),
+    (GridConfig::RandomInit, Metric::RandomInit),
+];
+
 /// The readings of the first counted run of `results`, from its own files
 /// ([`crate::grid::run_folder_config`]), under the grid's rescoring.
 fn readings(results: &GridResults) -> Vec<String> {
@@ -233,7 +242,7 @@ impl Report {
 
 /// The task columns: each task alone, then All (the grid's tasks pooled).
 fn task_columns(spec: &GridSpec) -> Vec<(String, Vec<Task>, Option<Task>)> {
-    let mut columns: Vec<_> = Task::ALL
+    let mut columns: Vec<_> = Task::VARIANTS
         .iter()
         .map(|&t| (t.number().to_string(), vec![t], Some(t)))
         .collect();
@@ -302,18 +311,10 @@ fn robustness_tables(results: &GridResults) -> [Table; 2] {
     let mut table2 = robustness_rows(results, BASELINE, Metric::Clean, None);
     table2.extend(robustness_rows(results, BASELINE, Metric::InputNoise, None));
     table2.extend(robustness_rows(results, BASELINE, Metric::RandomInit, None));
-    let mut table3 = robustness_rows(
-        results,
-        GridConfig::InputNoise,
-        Metric::InputNoise,
-        Some((BASELINE, Metric::InputNoise)),
-    );
-    table3.extend(robustness_rows(
-        results,
-        GridConfig::RandomInit,
-        Metric::RandomInit,
-        Some((BASELINE, Metric::RandomInit)),
-    ));
+    let table3 = TABLE3_CONFIGS
+        .iter()
+        .flat_map(|&(config, test)| robustness_rows(results, config, test, Some((BASELINE, test))))
+        .collect();
     [
         Table {
             id: "2".into(),
@@ -434,4 +435,23 @@ fn missing_cells(results: &GridResults) -> Vec<MissingCell> {
         }
     }
     cells
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A configuration added to the grid without a table would run and
+    /// be missing from every report.
+    #[test]
+    fn every_configuration_has_one_table() {
+        for config in GridConfig::all() {
+            let champion = CHAMPION_TABLES
+                .iter()
+                .filter(|(_, _, configs)| configs.contains(&config))
+                .count();
+            let table3 = TABLE3_CONFIGS.iter().filter(|(c, _)| *c == config).count();
+            assert_eq!(champion + table3, 1, "{config} has {} tables", champion + table3);
+        }
+    }
 }

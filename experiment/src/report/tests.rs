@@ -1,6 +1,7 @@
 //! The report on synthetic grids with hand-chosen numbers.
 
 use std::path::{Path, PathBuf};
+use strum::VariantArray;
 
 use super::*;
 use crate::champion::robustness::{Robustness, TrialSummary};
@@ -423,7 +424,7 @@ fn distance_terms_follow_their_definitions() {
     // No task 3 here: the burst totals and their ratio are missing, not counted.
     assert!(d.missing.iter().any(|m| m == "bursts max-credit / baseline"));
     assert!(d.missing.iter().any(|m| m.starts_with("bursts baseline")));
-    let parts: f64 = Part::ALL
+    let parts: f64 = Part::VARIANTS
         .iter()
         .map(|&p| d.terms.iter().filter(|t| t.part == p).map(|t| t.z * t.z).sum::<f64>())
         .sum();
@@ -438,7 +439,7 @@ fn distance_terms_follow_their_definitions() {
 fn the_burst_ratio_is_max_credit_over_baseline_in_the_se_of_two_counts() {
     let dir = tempfile::tempdir().unwrap();
     let spec = GridSpec {
-        tasks: Task::ALL.to_vec(),
+        tasks: Task::VARIANTS.to_vec(),
         ..spec()
     };
     spec.save(dir.path()).unwrap();

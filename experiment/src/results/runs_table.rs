@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use psa_sim::named::Named;
 
 use crate::grid::run_dir;
 use crate::results::columns::{csv_field, header, row, Column};

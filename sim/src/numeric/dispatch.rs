@@ -2,8 +2,9 @@
 //! run time so that one portable binary uses AVX-512 or AVX2 where the CPU
 //! has them and plain x86-64 (SSE2) or the target's baseline elsewhere.
 
-use std::fmt;
-use std::str::FromStr;
+use strum::VariantArray;
+
+use crate::named::Named;
 
 /// Calls the macro `$callback!` with its arguments followed by the
 /// `multiversion` targets of
@@ -57,8 +58,23 @@ crate::with_simd_targets!(targets!());
 
 /// An instruction-set level for the batched path. Every level computes
 /// bit-identical results; only the speed differs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    serde::Serialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum SimdLevel {
     /// The target's baseline (SSE2 on x86-64): runs on any CPU, slowly,
     /// as every fused multiply-add is a function call.
@@ -70,13 +86,11 @@ pub enum SimdLevel {
 }
 
 impl SimdLevel {
-    /// Every level, slowest first.
-    pub const ALL: [SimdLevel; 3] = [SimdLevel::Portable, SimdLevel::Avx2, SimdLevel::Avx512];
-
     /// The best level this CPU supports.
     pub fn detect() -> SimdLevel {
-        SimdLevel::ALL
-            .into_iter()
+        SimdLevel::VARIANTS
+            .iter()
+            .copied()
             .rev()
             .find(|l| l.is_supported())
             .unwrap_or(SimdLevel::Portable)
@@ -102,29 +116,8 @@ impl SimdLevel {
             SimdLevel::Avx512 => Some(AVX512_TARGET),
         }
     }
-
-    /// The level's name as the command line spells it.
-    pub const fn name(self) -> &'static str {
-        match self {
-            SimdLevel::Portable => "portable",
-            SimdLevel::Avx2 => "avx2",
-            SimdLevel::Avx512 => "avx512",
-        }
-    }
 }
 
-impl fmt::Display for SimdLevel {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for SimdLevel {
-    type Err = String;
-    fn from_str(s: &str) -> Result<SimdLevel, String> {
-        SimdLevel::ALL
-            .into_iter()
-            .find(|l| l.name() == s)
-            .ok_or_else(|| format!("SIMD level must be portable, avx2 or avx512, got {s:?}"))
-    }
+impl Named for SimdLevel {
+    const WHAT: &'static str = "SIMD level";
 }

@@ -5,7 +5,7 @@
 //! from which one more step could leave the finite numbers, and ODE is
 //! never called with one.
 //!
-//! The envelope is far beyond anything the ranges of `psa::limits` let a
+//! The envelope is far beyond anything the ranges of `psa::settings::limits` let a
 //! trial reach (a test flies the most violent body they allow at full
 //! thrust for the longest trial): it only stops input that was never
 //! validated.

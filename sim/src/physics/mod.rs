@@ -12,10 +12,8 @@ mod ode_fleet;
 #[cfg(feature = "rapier")]
 mod rapier_backend;
 
-use std::fmt;
-use std::str::FromStr;
-
 use serde::{Deserialize, Serialize};
+use strum::VariantArray;
 use thiserror::Error;
 
 pub use crosscheck::{
@@ -30,6 +28,7 @@ pub use ode_fleet::{OdeFleet, MAX_FLEET};
 #[cfg(feature = "rapier")]
 pub use rapier_backend::RapierBackend;
 
+use crate::named::Named;
 use crate::ode::OdeError;
 
 /// Errors of the physics layer.
@@ -197,8 +196,22 @@ impl StepSettings {
 }
 
 /// Which physics engine simulates the body.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Hash,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum BackendKind {
     /// The Open Dynamics Engine through `ode-sys` (the faithful default).
     Ode,
@@ -209,18 +222,6 @@ pub enum BackendKind {
 }
 
 impl BackendKind {
-    /// Every backend, the reference (`ode`) first.
-    pub const ALL: [BackendKind; 3] = [BackendKind::Ode, BackendKind::Native, BackendKind::Rapier];
-
-    /// The backend's command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            BackendKind::Ode => "ode",
-            BackendKind::Native => "native",
-            BackendKind::Rapier => "rapier",
-        }
-    }
-
     /// Whether this build includes the backend.
     pub fn is_available(self) -> bool {
         self != BackendKind::Rapier || cfg!(feature = "rapier")
@@ -228,24 +229,12 @@ impl BackendKind {
 
     /// The backends this build includes.
     pub fn available() -> Vec<BackendKind> {
-        Self::ALL.into_iter().filter(|k| k.is_available()).collect()
+        Self::VARIANTS.iter().copied().filter(|k| k.is_available()).collect()
     }
 }
 
-impl fmt::Display for BackendKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for BackendKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        BackendKind::ALL
-            .into_iter()
-            .find(|k| k.name() == s)
-            .ok_or_else(|| format!("unknown backend {s:?} (expected ode, native or rapier)"))
-    }
+impl Named for BackendKind {
+    const WHAT: &'static str = "backend";
 }
 
 /// One simulated body: reset it to a state, push it, read its state back.

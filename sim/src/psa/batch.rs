@@ -29,7 +29,8 @@
 use multiversion::multiversion;
 
 use super::step::{score, sense, Reading};
-use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
+use super::trial::{mean_of_trials, TrialRunner};
+use super::{PsaError, PsaSettings};
 use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use std::ops::Range;
 

@@ -47,10 +47,10 @@ impl Default for BodySettings {
 }
 
 impl BodySettings {
-    /// Rejects values outside their [ranges](super::limits).
+    /// Rejects values outside their [ranges](super::settings::limits).
     pub fn validate(&self) -> Result<(), PhysicsError> {
         let [length, width, height] = self.thruster_size;
-        super::limits::check_all(&[
+        super::settings::limits::check_all(&[
             ("body.hull_radius", self.hull_radius),
             ("body.hull_height", self.hull_height),
             ("body.thruster_size", length),

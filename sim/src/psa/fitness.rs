@@ -124,9 +124,9 @@ pub struct StepError<R = f64> {
 }
 
 impl FitnessSettings {
-    /// Rejects values outside their [ranges](super::limits).
+    /// Rejects values outside their [ranges](super::settings::limits).
     pub fn validate(&self) -> Result<(), String> {
-        super::limits::check_all(&[
+        super::settings::limits::check_all(&[
             ("fitness.box_half_width", self.box_half_width),
             ("fitness.heading_window", self.heading_window),
             ("fitness.spin_window", self.spin_window),

@@ -5,22 +5,23 @@
 pub mod batch;
 pub mod body;
 pub mod cuda;
-pub mod defaults;
+pub mod error;
 pub mod fitness;
-pub mod limits;
 pub mod network_file;
 pub mod ode_lockstep;
-pub mod readings;
 pub mod sensors;
+pub mod settings;
 pub mod step;
 pub mod task;
 pub mod trial;
 
 pub use batch::BatchRunner;
 pub use body::{BodySettings, THRUSTER_COUNT};
+pub use error::PsaError;
 pub use fitness::{FitnessKind, FitnessSettings, FitnessState, Scoring, SlowingRule};
 pub use network_file::{NetworkFile, NetworkFileError};
 pub use ode_lockstep::OdeLockstepRunner;
 pub use sensors::{HeadingInput, HeadingWrap, NoiseSettings, SensorSettings, INPUT_COUNT};
+pub use settings::{PsaSettings, TaskOverrides};
 pub use task::{Target, Task, TaskSettings};
-pub use trial::{mean_of_trials, PsaError, PsaSettings, TaskOverrides, TrialRecord, TrialRunner};
+pub use trial::{mean_of_trials, TrialRecord, TrialRunner};

@@ -22,8 +22,8 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::sensors::SensorSettings;
+use super::settings::PsaSettings;
 use super::task::Task;
-use super::trial::PsaSettings;
 use crate::provenance::BuildInfo;
 use esp_neuroevolution::network::Network;
 
@@ -143,8 +143,8 @@ impl NetworkFile {
         provenance.insert("tool_version".into(), build.tool_version.clone().into());
         provenance.insert("git_commit".into(), build.git_commit.clone().into());
         provenance.insert("libode_version".into(), build.libode_version.clone().into());
-        // Places the file in the table of defaults (see `psa::defaults`).
-        provenance.insert("defaults".into(), super::defaults::rows().into());
+        // Places the file in the table of defaults (see `psa::settings::defaults`).
+        provenance.insert("defaults".into(), super::settings::defaults::rows().into());
         provenance.extend(extra);
         NetworkFile {
             format: FORMAT.into(),
@@ -224,14 +224,16 @@ impl NetworkFile {
         }
         let mut value = value;
         // A file that lacks a setting (written before it existed) gets the
-        // value the build that wrote it used (`psa::defaults`).
-        let placement = super::defaults::Placement::of_json(value.get("provenance").and_then(|p| p.as_object()));
+        // value the build that wrote it used (`psa::settings::defaults`).
+        let placement =
+            super::settings::defaults::Placement::of_json(value.get("provenance").and_then(|p| p.as_object()));
         if let Some(problem) = value.get_mut("problem").filter(|p| p.is_object()) {
-            super::defaults::fill(problem, "problem.", &placement).map_err(|e| fail(format!("problem: {e}")))?;
+            super::settings::defaults::fill(problem, "problem.", &placement)
+                .map_err(|e| fail(format!("problem: {e}")))?;
         }
         // The input scaling is the problem's sensors, and lacks what they lack.
         if let Some(scaling) = value.get_mut("input_scaling").filter(|p| p.is_object()) {
-            super::defaults::fill(scaling, "problem.sensors.", &placement)
+            super::settings::defaults::fill(scaling, "problem.sensors.", &placement)
                 .map_err(|e| fail(format!("input_scaling: {e}")))?;
         }
         if let Some(problem) = value.get("problem") {

@@ -24,7 +24,8 @@ use std::ops::Range;
 use multiversion::multiversion;
 
 use super::step::{score, sense, Reading};
-use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
+use super::trial::{mean_of_trials, TrialRunner};
+use super::{PsaError, PsaSettings};
 use super::{Target, Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::numeric::{clamp_unit, NoiseSource};
 use crate::physics::{BackendKind, OdeFleet, PlanarState};

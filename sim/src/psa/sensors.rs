@@ -178,9 +178,9 @@ impl SensorSettings {
         ]
     }
 
-    /// Rejects values outside their [ranges](super::limits).
+    /// Rejects values outside their [ranges](super::settings::limits).
     pub fn validate(&self) -> Result<(), String> {
-        super::limits::check_all(&[
+        super::settings::limits::check_all(&[
             ("sensors.position_scale", self.position_scale),
             ("sensors.velocity_scale", self.velocity_scale),
             ("sensors.heading_scale", self.heading_scale),
@@ -208,9 +208,9 @@ pub struct NoiseSettings {
 }
 
 impl NoiseSettings {
-    /// Rejects deviations outside their [ranges](super::limits).
+    /// Rejects deviations outside their [ranges](super::settings::limits).
     pub fn validate(&self) -> Result<(), String> {
-        super::limits::check_all(&[("noise.input_sd", self.input_sd), ("noise.output_sd", self.output_sd)])
+        super::settings::limits::check_all(&[("noise.input_sd", self.input_sd), ("noise.output_sd", self.output_sd)])
     }
 
     /// Whether any noise is configured.

@@ -6,11 +6,12 @@ use std::fmt;
 
 use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
+use strum::VariantArray;
 
 use crate::physics::BodyState;
 
 /// One of the paper's tasks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, strum::VariantArray)]
 #[serde(try_from = "u8", into = "u8")]
 pub enum Task {
     /// Stop autorotation, hold heading and position.
@@ -22,12 +23,19 @@ pub enum Task {
 }
 
 impl Task {
-    /// All tasks in order.
-    pub const ALL: [Task; 3] = [Task::StopRotation, Task::Turn, Task::StopAtPosition];
-
     /// The task's number, 1 to 3.
     pub fn number(self) -> u8 {
         self as u8
+    }
+
+    /// The tasks' numbers in words, for messages: "1, 2 or 3".
+    fn numbers() -> String {
+        let numbers: Vec<String> = Task::VARIANTS.iter().map(|t| t.number().to_string()).collect();
+        match numbers.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => String::new(),
+        }
     }
 
     /// Whether the paper has a random-initialisation variant (tasks 1 and 3).
@@ -55,7 +63,7 @@ impl Task {
 
     /// Whether the paper ran this task (its tables have a column for it): a
     /// grid's default tasks and the report's comparisons with the paper ask
-    /// this, never [`Task::ALL`]. A task added later answers `false`.
+    /// this, never [`Task::VARIANTS`]. A task added later answers `false`.
     pub fn in_paper(self) -> bool {
         match self {
             Task::StopRotation | Task::Turn | Task::StopAtPosition => true,
@@ -66,12 +74,11 @@ impl Task {
 impl TryFrom<u8> for Task {
     type Error = String;
     fn try_from(n: u8) -> Result<Task, String> {
-        match n {
-            1 => Ok(Task::StopRotation),
-            2 => Ok(Task::Turn),
-            3 => Ok(Task::StopAtPosition),
-            _ => Err(format!("task must be 1, 2 or 3, got {n}")),
-        }
+        Task::VARIANTS
+            .iter()
+            .copied()
+            .find(|task| task.number() == n)
+            .ok_or_else(|| format!("task must be {}, got {n}", Task::numbers()))
     }
 }
 
@@ -87,7 +94,7 @@ impl std::str::FromStr for Task {
         let n: u8 = s
             .trim()
             .parse()
-            .map_err(|_| format!("task must be 1, 2 or 3, got {s:?}"))?;
+            .map_err(|_| format!("task must be {}, got {s:?}", Task::numbers()))?;
         Task::try_from(n)
     }
 }
@@ -157,11 +164,11 @@ impl Default for TaskSettings {
 }
 
 impl TaskSettings {
-    /// Rejects values outside their [ranges](super::limits) and an empty
+    /// Rejects values outside their [ranges](super::settings::limits) and an empty
     /// distance range.
     pub fn validate(&self) -> Result<(), String> {
         let [lo, hi] = self.task3_random_distance;
-        super::limits::check_all(&[
+        super::settings::limits::check_all(&[
             ("tasks.task1_spin", self.task1_spin),
             ("tasks.task2_target_heading", self.task2_target_heading),
             ("tasks.task2_spin", self.task2_spin),

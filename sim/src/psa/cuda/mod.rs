@@ -30,8 +30,9 @@ pub use device::{
 };
 pub use host::fly_on_host;
 
-use super::readings::READINGS;
-use super::trial::{mean_of_trials, PsaError, PsaSettings, TrialRunner};
+use super::settings::readings::READINGS;
+use super::trial::{mean_of_trials, TrialRunner};
+use super::{PsaError, PsaSettings};
 use super::{Task, INPUT_COUNT, THRUSTER_COUNT};
 use crate::physics::{BackendKind, PlanarBody, PlanarState};
 use esp_neuroevolution::network::{Network, NetworkSet};

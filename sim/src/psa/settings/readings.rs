@@ -3,7 +3,7 @@
 //! tag, the `trial.cu` define that compiles it into the cuda kernel, how
 //! reports name it and a value other than its default for the tests.
 //! [`PsaSettings::describe_readings`], the kernel's
-//! [`Specialisation`](super::cuda::Specialisation) and the tests'
+//! [`Specialisation`](crate::psa::cuda::Specialisation) and the tests'
 //! settings under every reading iterate [`READINGS`]; a test holds
 //! `docs/specification.md`'s table of readings to it, and another fails on
 //! a discrete setting that is neither a row nor named as no reading.
@@ -13,11 +13,12 @@
 //! here, and a row in the specification's table.
 
 use std::fmt;
+use strum::VariantArray;
 
-use super::fitness::{FitnessKind, FitnessState, Scoring, SlowingRule};
-use super::sensors::{HeadingInput, HeadingWrap, NoiseStage};
-use super::task::Task;
-use super::trial::PsaSettings;
+use super::PsaSettings;
+use crate::psa::fitness::{FitnessKind, FitnessState, Scoring, SlowingRule};
+use crate::psa::sensors::{HeadingInput, HeadingWrap, NoiseStage};
+use crate::psa::task::Task;
 
 /// Where a reading's default comes from (`docs/specification.md`'s tags).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -104,7 +105,7 @@ fn fitness_name(kind: FitnessKind) -> &'static str {
 /// Each task's line: the fitness it evolves on, over how many steps, and
 /// the one its champions are scored on.
 fn describe_tasks(evolved: &PsaSettings, scoring: &PsaSettings) -> Vec<String> {
-    Task::ALL
+    Task::VARIANTS
         .iter()
         .filter_map(|&task| {
             let s = evolved.for_task(task).ok()?;
@@ -278,6 +279,24 @@ pub fn every_test_value(mut settings: PsaSettings) -> PsaSettings {
     settings
 }
 
+impl PsaSettings {
+    /// The readings of the inputs and the fitness these settings fly, in
+    /// words, for reports: the lines of every row of [`READINGS`] in order
+    /// (per task the fitness evolved on, the trial's length and the fitness
+    /// champions are scored on under `scoring`, these settings or the ones
+    /// a re-scored grid tests with; the heading input; the noise on the
+    /// bias; the state the fitness reads).
+    pub fn describe_readings(&self, scoring: &PsaSettings) -> Vec<String> {
+        READINGS
+            .iter()
+            .flat_map(|row| match row.describe {
+                Describe::Lines(lines) => lines(self, scoring),
+                Describe::With(_) => Vec::new(),
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::collections::BTreeSet;
@@ -363,7 +382,12 @@ mod tests {
     #[test]
     fn every_row_s_test_value_is_not_the_default_and_shows() {
         let default = PsaSettings::default();
-        let resolved = |s: &PsaSettings| Task::ALL.map(|t| s.for_task(t).unwrap());
+        let resolved = |s: &PsaSettings| {
+            Task::VARIANTS
+                .iter()
+                .map(|&t| s.for_task(t).unwrap())
+                .collect::<Vec<_>>()
+        };
         for row in READINGS {
             let mut s = PsaSettings::default();
             (row.set_test_value)(&mut s);
@@ -436,9 +460,9 @@ mod tests {
 
     #[test]
     fn the_specification_s_table_of_readings_is_the_table() {
-        let spec = include_str!("../../../docs/specification.md");
+        let spec = include_str!("../../../../docs/specification.md");
         let table = spec
-            .split("<!-- readings: the rows of psa::readings::READINGS -->")
+            .split("<!-- readings: the rows of psa::settings::readings::READINGS -->")
             .nth(1)
             .expect("the specification has the table of readings");
         let rows: Vec<String> = table

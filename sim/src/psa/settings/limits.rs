@@ -227,7 +227,7 @@ pub fn check_as(key: &str, shown: &str, value: f64) -> Result<(), String> {
     match limit(key) {
         Some(l) => l.check_as(shown, value),
         None => Err(format!(
-            "{shown}: no range is defined for key {key:?} (a bug: add it to psa::limits::LIMITS)"
+            "{shown}: no range is defined for key {key:?} (a bug: add it to psa::settings::limits::LIMITS)"
         )),
     }
 }
@@ -250,9 +250,43 @@ mod tests {
         }
     }
 
+    /// The dotted keys of the numbers in `value` (a number or an array of
+    /// numbers is one key), under `prefix`.
+    fn numeric_keys(value: &serde_json::Value, prefix: &str, keys: &mut Vec<String>) {
+        use serde_json::Value;
+        match value {
+            Value::Number(_) => keys.push(prefix.to_string()),
+            Value::Array(items) if items.iter().all(Value::is_number) => keys.push(prefix.to_string()),
+            Value::Object(fields) => {
+                for (name, field) in fields {
+                    let key = if prefix.is_empty() {
+                        name.clone()
+                    } else {
+                        format!("{prefix}.{name}")
+                    };
+                    numeric_keys(field, &key, keys);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// A numeric setting added to [`PsaSettings`](crate::psa::PsaSettings)
+    /// without a row would take any value, NaN included. (The tasks'
+    /// `steps`, absent from the defaults, are checked against `steps`.)
+    #[test]
+    fn every_numeric_setting_has_a_row() {
+        let defaults = serde_json::to_value(crate::psa::PsaSettings::default()).unwrap();
+        let mut keys = Vec::new();
+        numeric_keys(&defaults, "", &mut keys);
+        assert!(keys.len() > 30, "{keys:?}");
+        let missing: Vec<&String> = keys.iter().filter(|k| limit(k).is_none()).collect();
+        assert!(missing.is_empty(), "settings without a row in LIMITS: {missing:?}");
+    }
+
     #[test]
     fn the_documentation_lists_every_key() {
-        let doc = include_str!("../../../docs/limits.md");
+        let doc = include_str!("../../../../docs/limits.md");
         for l in LIMITS {
             assert!(doc.contains(&format!("`{}`", l.key)), "docs/limits.md lacks {}", l.key);
         }
