@@ -58,8 +58,8 @@ pub struct Robustness {
 }
 
 /// The settings of a champion's clean test under `problem` on `task`:
-/// scored with its scoring fitness, without noise (but for whether noise
-/// would reach the bias), from the task's start, one trial. The noisy and
+/// scored with its scoring fitness, without noise (but for where noise
+/// would enter and whether it would reach the bias), from the task's start, one trial. The noisy and
 /// random-start tests are these with the paper's noise, random starts and
 /// the test's trials; so two problems with the same tested settings give
 /// the same robustness results.
@@ -68,6 +68,7 @@ pub fn tested_settings(problem: &PsaSettings, task: Task) -> Result<PsaSettings>
     Ok(PsaSettings {
         noise: NoiseSettings {
             on_bias: problem.noise.on_bias,
+            stage: problem.noise.stage,
             ..NoiseSettings::default()
         },
         random_init: false,

@@ -46,6 +46,21 @@ impl HeadingWrap {
     }
 }
 
+/// Where the input noise enters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseStage {
+    /// On the inputs as the network reads them, after scaling: an sd of
+    /// 0.05 input units on every input. `[chosen]` default
+    #[default]
+    Scaled,
+    /// On the quantities the sensors measure, before scaling: an sd of
+    /// 0.05 m, m/s, rad and rad/s, which the scales then enlarge (ten-fold
+    /// on positions and velocities at the default scales); the bias, which
+    /// measures nothing, gets its noise (with `on_bias`) as it is.
+    Raw,
+}
+
 /// Input scaling (`[chosen]` values; the paper's inputs were O(1) or larger).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -117,14 +132,49 @@ impl SensorSettings {
         heading_reading: R,
         omega: R,
     ) -> [R; INPUT_COUNT] {
-        [
-            offset[0] * R::splat(self.position_scale),
-            offset[1] * R::splat(self.position_scale),
-            velocity[0] * R::splat(self.velocity_scale),
-            velocity[1] * R::splat(self.velocity_scale),
-            heading_reading * R::splat(self.heading_scale),
-            omega * R::splat(self.angular_velocity_scale),
+        self.scaled(Self::measured(
+            offset,
+            velocity,
+            heading_reading,
+            omega,
             R::splat(self.bias),
+        ))
+    }
+
+    /// What the sensors measure, in the inputs' order, before scaling:
+    /// the position relative to the target, the velocity, the heading
+    /// reading, omega, and the bias as it is.
+    #[inline(always)]
+    pub fn measured<R: Real>(
+        offset: [R; 2],
+        velocity: [R; 2],
+        heading_reading: R,
+        omega: R,
+        bias: R,
+    ) -> [R; INPUT_COUNT] {
+        [
+            offset[0],
+            offset[1],
+            velocity[0],
+            velocity[1],
+            heading_reading,
+            omega,
+            bias,
+        ]
+    }
+
+    /// The inputs from what the sensors measure ([`SensorSettings::measured`]):
+    /// each quantity times its scale, the bias as it is.
+    #[inline(always)]
+    pub fn scaled<R: Real>(&self, measured: [R; INPUT_COUNT]) -> [R; INPUT_COUNT] {
+        [
+            measured[0] * R::splat(self.position_scale),
+            measured[1] * R::splat(self.position_scale),
+            measured[2] * R::splat(self.velocity_scale),
+            measured[3] * R::splat(self.velocity_scale),
+            measured[4] * R::splat(self.heading_scale),
+            measured[5] * R::splat(self.angular_velocity_scale),
+            measured[6],
         ]
     }
 
@@ -152,6 +202,9 @@ pub struct NoiseSettings {
     /// Whether the input noise reaches the bias unit too ("added to each
     /// input neuron"; the bias is one of the seven input units). `[chosen]` false
     pub on_bias: bool,
+    /// Where the input noise enters: on the scaled inputs or on what the
+    /// sensors measure, before scaling. `[chosen]` scaled
+    pub stage: NoiseStage,
 }
 
 impl NoiseSettings {

@@ -7,7 +7,7 @@
 use super::fitness::FitnessSettings;
 use super::fitness::{FitnessState, StepError};
 use super::sensors::INPUT_COUNT;
-use super::sensors::{NoiseSettings, SensorSettings};
+use super::sensors::{NoiseSettings, NoiseStage, SensorSettings};
 use crate::numeric::{wrap_angle, Normals, Real};
 
 /// The settings one step reads: how the sensors read and are perturbed,
@@ -47,10 +47,18 @@ pub fn sense<R: Real, const NOISY: bool>(
     let heading_error = wrap_angle(heading - target[2]);
     let offset = [position[0] - target[0], position[1] - target[1]];
     let sensors = settings.sensors;
-    let mut inputs = sensors.inputs_from(offset, velocity, sensors.heading_reading(heading, heading_error), omega);
-    if NOISY {
-        settings.noise.perturb_inputs(&mut inputs, noise);
-    }
+    let heading_reading = sensors.heading_reading(heading, heading_error);
+    let inputs = if NOISY && settings.noise.stage == NoiseStage::Raw {
+        let mut measured = SensorSettings::measured(offset, velocity, heading_reading, omega, R::splat(sensors.bias));
+        settings.noise.perturb_inputs(&mut measured, noise);
+        sensors.scaled(measured)
+    } else {
+        let mut inputs = sensors.inputs_from(offset, velocity, heading_reading, omega);
+        if NOISY {
+            settings.noise.perturb_inputs(&mut inputs, noise);
+        }
+        inputs
+    };
     Reading { inputs, heading_error }
 }
 
@@ -188,6 +196,51 @@ mod tests {
         // The other inputs draw the same numbers either way.
         assert_eq!(without[..6], with[..6]);
         assert!(without[..6].iter().all(|&v| v != 0.0));
+    }
+
+    #[test]
+    fn raw_input_noise_is_added_before_scaling_and_scaled_noise_after() {
+        let mut s = Settings::default();
+        s.noise.input_sd = 0.05;
+        s.noise.on_bias = true;
+        s.sensors.heading_scale = 2.0;
+        let (offset, velocity, heading, omega) = ([0.03, -0.2], [0.1, -0.05], 0.7, -1.5);
+        let read = |s: &Settings| {
+            sense::<f64, true>(
+                s.step(),
+                offset,
+                velocity,
+                heading,
+                omega,
+                [0.0; 3],
+                &mut NoiseSource::new(11),
+            )
+            .inputs
+        };
+        // The normal numbers the source draws, in the inputs' order.
+        let mut draws = [0.0; INPUT_COUNT];
+        NoiseSource::new(11).add_scaled(&mut draws, 1.0);
+        let scales = [10.0, 10.0, 10.0, 10.0, 2.0, 1.0];
+        let measured = [offset[0], offset[1], velocity[0], velocity[1], heading, omega];
+        let scaled = read(&s);
+        s.noise.stage = NoiseStage::Raw;
+        let raw = read(&s);
+        for i in 0..6 {
+            assert_eq!(
+                scaled[i],
+                measured[i] * scales[i] + 0.05 * draws[i],
+                "input {i}, scaled"
+            );
+            assert_eq!(raw[i], (measured[i] + 0.05 * draws[i]) * scales[i], "input {i}, raw");
+        }
+        // The bias measures nothing: its noise is the same at either stage.
+        assert_eq!(raw[6], scaled[6]);
+        assert_eq!(raw[6], s.sensors.bias + 0.05 * draws[6]);
+        // Without noise the stage changes nothing.
+        s.noise.input_sd = 0.0;
+        let clean = read(&s);
+        s.noise.stage = NoiseStage::Scaled;
+        assert_eq!(read(&s), clean);
     }
 
     #[test]

@@ -22,6 +22,7 @@
  *   PSA_HEADING_ABSOLUTE  the heading input: 1 the heading, 0 the error against the target
  *   PSA_HEADING_POSITIVE  its wrap range: 1 [0, 2 pi), 0 (-pi, pi]
  *   PSA_BIAS_NOISE        input noise on the bias too
+ *   PSA_NOISE_RAW         input noise on what the sensors measure, before scaling (0: on the scaled inputs)
  *   PSA_FITNESS_SENSED    the fitness reads the sensed state (the inputs over their scales)
  *   PSA_FORCE_SUPPORT, PSA_ARM_SUPPORT   per thruster, which components are kept
  *   PSA_EXP_TERMS, PSA_EXP_Q             the exponential's q, highest first (hex floats)
@@ -30,7 +31,7 @@
 
 #if !defined(PSA_HIDDEN) || !defined(PSA_NOISY) || !defined(PSA_INCREMENTAL) || !defined(PSA_SIGNED_SLOWING) ||     \
     !defined(PSA_HEADING_ABSOLUTE) || !defined(PSA_HEADING_POSITIVE) || !defined(PSA_BIAS_NOISE) ||                 \
-    !defined(PSA_FITNESS_SENSED) || !defined(PSA_FORCE_SUPPORT) || !defined(PSA_ARM_SUPPORT) ||                     \
+    !defined(PSA_NOISE_RAW) || !defined(PSA_FITNESS_SENSED) || !defined(PSA_FORCE_SUPPORT) || !defined(PSA_ARM_SUPPORT) ||                     \
     !defined(PSA_EXP_TERMS) || !defined(PSA_EXP_Q) || !defined(PSA_LN2_TERMS) || !defined(PSA_LN2_PARTS)
 #error "trial.cu is compiled with its specialisation's -D options (cuda::Specialisation::defines)"
 #endif
@@ -297,14 +298,23 @@ PSA_FN void psa_sense(const PsaParams *p, double px, double py, double vx, doubl
     *heading_error = psa_wrap_angle(heading - th);
     double reading = PSA_HEADING_ABSOLUTE ? psa_wrap_angle(heading) : *heading_error;
     if (PSA_HEADING_POSITIVE && reading < 0.0) reading = reading + PSA_TAU;
-    inputs[0] = (px - tx) * p->position_scale;
-    inputs[1] = (py - ty) * p->position_scale;
-    inputs[2] = vx * p->velocity_scale;
-    inputs[3] = vy * p->velocity_scale;
-    inputs[4] = reading * p->heading_scale;
-    inputs[5] = omega * p->angular_velocity_scale;
+    inputs[0] = px - tx;
+    inputs[1] = py - ty;
+    inputs[2] = vx;
+    inputs[3] = vy;
+    inputs[4] = reading;
+    inputs[5] = omega;
     inputs[6] = p->bias;
-    if (PSA_NOISY && p->input_sd > 0.0)
+    /* psa::sensors::NoiseStage: before scaling (raw) or after it */
+    if (PSA_NOISY && PSA_NOISE_RAW && p->input_sd > 0.0)
+        psa_add_scaled(noise, inputs, PSA_BIAS_NOISE ? PSA_INPUTS : PSA_INPUTS - 1, p->input_sd);
+    inputs[0] = inputs[0] * p->position_scale;
+    inputs[1] = inputs[1] * p->position_scale;
+    inputs[2] = inputs[2] * p->velocity_scale;
+    inputs[3] = inputs[3] * p->velocity_scale;
+    inputs[4] = inputs[4] * p->heading_scale;
+    inputs[5] = inputs[5] * p->angular_velocity_scale;
+    if (PSA_NOISY && !PSA_NOISE_RAW && p->input_sd > 0.0)
         psa_add_scaled(noise, inputs, PSA_BIAS_NOISE ? PSA_INPUTS : PSA_INPUTS - 1, p->input_sd);
 }
 

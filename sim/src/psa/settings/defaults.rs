@@ -107,6 +107,7 @@ pub const CHANGES: &[Change] = &[
     first("hill_climb.alpha", "1.0"),
     changed("hill_climb.alpha", "", "0.3"),
     changed("problem.tasks.task2_spin", "", "-1.5"),
+    first("problem.noise.stage", r#""scaled""#),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.

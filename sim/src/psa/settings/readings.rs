@@ -17,7 +17,7 @@ use strum::VariantArray;
 
 use super::PsaSettings;
 use crate::psa::fitness::{FitnessKind, FitnessState, Scoring, SlowingRule};
-use crate::psa::sensors::{HeadingInput, HeadingWrap};
+use crate::psa::sensors::{HeadingInput, HeadingWrap, NoiseStage};
 use crate::psa::task::Task;
 
 /// Where a reading's default comes from (`docs/specification.md`'s tags).
@@ -205,6 +205,26 @@ pub const READINGS: &[Reading] = &[
             )]
         }),
         set_test_value: |s| s.noise.on_bias = true,
+    },
+    Reading {
+        key: "noise.stage",
+        doc: "where the input noise enters: `scaled` (on the inputs, in input units) or `raw` (on what the sensors measure, before scaling)",
+        tag: Tag::Chosen,
+        define: Some(Define {
+            name: "PSA_NOISE_RAW",
+            on: |s| s.noise.stage == NoiseStage::Raw,
+        }),
+        task_key: None,
+        describe: Describe::Lines(|s, _| {
+            vec![format!(
+                "input noise: {}",
+                match s.noise.stage {
+                    NoiseStage::Scaled => "on the scaled inputs",
+                    NoiseStage::Raw => "on what the sensors measure, before scaling",
+                }
+            )]
+        }),
+        set_test_value: |s| s.noise.stage = NoiseStage::Raw,
     },
     Reading {
         key: "fitness.state",
