@@ -237,3 +237,92 @@ fn evolve_rejects_bad_arguments_with_a_clear_message() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn a_traced_evolve_is_the_untraced_run_and_traces_every_generation() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = small_config(dir.path());
+    let run = |name: &str, trace: Option<&Path>| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "evolve".to_string(),
+            "--task".into(),
+            "2".into(),
+            "--seed".into(),
+            "5".into(),
+            "--generations".into(),
+            "40".into(),
+            "--config".into(),
+            config.clone(),
+            "--out".into(),
+            out.display().to_string(),
+        ];
+        if let Some(trace) = trace {
+            args.extend(["--trace".into(), trace.display().to_string()]);
+        }
+        let o = psa_esp(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (
+            std::fs::read(out.join("records.csv")).unwrap(),
+            std::fs::read(out.join("champion.json")).unwrap(),
+        )
+    };
+    let trace = dir.path().join("trace.csv");
+    let traced = run("traced", Some(&trace));
+    assert!(traced == run("plain", None), "tracing changed the run");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 41, "{text}");
+    assert!(lines[0].starts_with("generation,max,champion,subpops,burst,topology,top_first_pass"));
+    // The trace's max and champion are the records' own, and bursts and
+    // topology changes show (stagnation 3 in 40 generations).
+    let records = String::from_utf8(traced.0).unwrap();
+    for (t, r) in lines[1..].iter().zip(records.lines().skip(1)) {
+        let (t, r): (Vec<&str>, Vec<&str>) = (t.split(',').collect(), r.split(',').collect());
+        assert_eq!(t[0], r[0]);
+        let fitness = |s: &str| s.parse::<f64>().unwrap();
+        assert!(
+            r.iter().any(|v| v.parse::<f64>().is_ok_and(|v| v == fitness(t[1]))),
+            "{t:?} {r:?}"
+        );
+        for rank in &t[11..13] {
+            assert!((0.0..=1.0).contains(&fitness(rank)), "{t:?}");
+        }
+    }
+    assert!(lines[1..].iter().any(|l| l.split(',').nth(4) == Some("1")), "{text}");
+    assert!(lines[1..].iter().any(|l| l.split(',').nth(5) != Some("")), "{text}");
+
+    // An existing trace is never overwritten; the hill-climber has no sub-populations.
+    let again = dir.path().join("again");
+    let o = psa_esp(&[
+        "evolve",
+        "--task",
+        "2",
+        "--generations",
+        "2",
+        "--config",
+        &config,
+        "--out",
+        again.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("trace file"));
+    let o = psa_esp(&[
+        "evolve",
+        "--task",
+        "2",
+        "--preset",
+        "hill-climb",
+        "--generations",
+        "2",
+        "--out",
+        again.to_str().unwrap(),
+        "--trace",
+        dir.path().join("hc.csv").to_str().unwrap(),
+    ]);
+    assert!(
+        !o.status.success() && String::from_utf8_lossy(&o.stderr).contains("hill-climber"),
+        "{o:?}"
+    );
+}

@@ -125,6 +125,20 @@ impl<'a> Asked<'a> {
         &self.key
     }
 
+    /// Which neuron of each sub-population network `j` takes (its index in
+    /// the sub-population as the generation's credit sees it), for ESP's
+    /// generation networks; `None` for whole networks (lesion tests, the
+    /// hill-climber) and for `j` out of range. With the networks' fitness,
+    /// [`Credit::neuron_credits`](crate::Credit::neuron_credits) gives the
+    /// credit ESP ranks the neurons by: an observer of a run can follow
+    /// each neuron without changing the run.
+    pub fn picks(&self, j: usize) -> Option<&[usize]> {
+        match &self.networks {
+            Networks::Set(set) if j < set.picks.count() => set.picks.networks().nth(j),
+            _ => None,
+        }
+    }
+
     /// The networks' streams: network `j` takes `streams().stream(j)`.
     pub fn streams(&self) -> StreamFamily {
         StreamFamily::new(self.seed, &self.key)

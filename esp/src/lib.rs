@@ -110,7 +110,7 @@ pub(crate) mod purpose {
 }
 
 /// The first position of the highest fitness, and that fitness.
-pub(crate) fn best_of(fitness: &[f64]) -> (usize, f64) {
+pub fn best_of(fitness: &[f64]) -> (usize, f64) {
     fitness.iter().enumerate().fold(
         (0, f64::NEG_INFINITY),
         |best, (j, &f)| if f > best.1 { (j, f) } else { best },

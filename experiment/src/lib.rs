@@ -21,6 +21,7 @@ pub mod plots;
 pub mod report;
 pub mod results;
 mod run;
+pub mod trace;
 
 pub use config::{
     paper_esp_settings, Algorithm, GridConfig, GridConfigKind, Preset, RunConfig, BASELINE, PAPER_NOISE_SD,
@@ -28,7 +29,7 @@ pub use config::{
 };
 pub use report::{write_report, ReportFormat, ReportOutcome};
 pub use results::EvolveOutcome;
-pub use run::{records_csv, run_evolution, RunFiles, RunStart};
+pub use run::{records_csv, run_evolution, run_evolution_traced, RunFiles, RunStart};
 
 /// The build's identity, recorded in every result file: this crate's
 /// version, the git commit (stamped by this crate's `build.rs`, with

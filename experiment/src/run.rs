@@ -174,6 +174,40 @@ pub fn run_evolution(
     seed: u64,
     dir: &Path,
     path: &EvalPath,
+    on_generation: impl FnMut(&GenerationRecord),
+) -> Result<EvolveOutcome> {
+    evolve(config, label, task, seed, dir, path, None, on_generation)
+}
+
+/// [`run_evolution`] with a trace ([`crate::trace`]) written to `trace`:
+/// the same run, bit for bit. ESP only (the hill-climber has no
+/// sub-populations to trace): refused otherwise.
+#[allow(clippy::too_many_arguments)]
+pub fn run_evolution_traced(
+    config: &RunConfig,
+    label: &str,
+    task: Task,
+    seed: u64,
+    dir: &Path,
+    path: &EvalPath,
+    trace: &Path,
+    on_generation: impl FnMut(&GenerationRecord),
+) -> Result<EvolveOutcome> {
+    if config.algorithm != Algorithm::Esp {
+        anyhow::bail!("--trace follows ESP's sub-populations; the hill-climber has none to trace");
+    }
+    evolve(config, label, task, seed, dir, path, Some(trace), on_generation)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn evolve(
+    config: &RunConfig,
+    label: &str,
+    task: Task,
+    seed: u64,
+    dir: &Path,
+    path: &EvalPath,
+    trace: Option<&Path>,
     mut on_generation: impl FnMut(&GenerationRecord),
 ) -> Result<EvolveOutcome> {
     let mut started = RunStart::new(config, dir)?;
@@ -182,11 +216,18 @@ pub fn run_evolution(
         started.record(record);
         on_generation(record);
     };
-    let result: RunResult = match config.algorithm {
-        Algorithm::Esp => Esp::new(config.esp.clone(), seed)
+    let result: RunResult = match (config.algorithm, trace) {
+        (Algorithm::Esp, Some(trace)) => {
+            let esp = Esp::new(config.esp.clone(), seed).map_err(anyhow::Error::msg)?;
+            let scoring = config.problem.scoring_for(task)?;
+            let (result, lines) = crate::trace::traced_run(&esp, &evaluator, &scoring, task, on_generation)?;
+            crate::trace::write_trace(trace, &lines)?;
+            result
+        }
+        (Algorithm::Esp, _) => Esp::new(config.esp.clone(), seed)
             .map_err(anyhow::Error::msg)?
             .run(&evaluator, on_generation)?,
-        Algorithm::HillClimb => HillClimb::new(config.hill_climb.clone(), seed)
+        (Algorithm::HillClimb, _) => HillClimb::new(config.hill_climb.clone(), seed)
             .map_err(anyhow::Error::msg)?
             .run(&evaluator, on_generation)?,
     };

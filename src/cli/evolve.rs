@@ -7,7 +7,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::backend::{BackendArg, EvalPathArg};
 use super::choice::choice;
-use psa_experiment::{run_evolution, Preset};
+use esp_neuroevolution::GenerationRecord;
+use psa_experiment::{run_evolution, run_evolution_traced, Preset};
 use psa_sim::named::Named;
 use psa_sim::ode::MAX_THREADS;
 use psa_sim::psa::Task;
@@ -42,6 +43,12 @@ pub struct EvolveArgs {
     /// Output directory (default: evolve-<preset>-task<T>-seed<S>).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Also write a per-generation trace CSV here (ESP only): each
+    /// generation's best network flown once on the scoring fitness
+    /// (first-pass landing or not) and its neurons' credit ranks; the run
+    /// is the same, bit for bit. An existing file is refused.
+    #[arg(long)]
+    pub trace: Option<PathBuf>,
     /// Print the run summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -90,24 +97,27 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
             out.display()
         );
     }
+    if let Some(trace) = args.trace.as_deref().filter(|t| t.symlink_metadata().is_ok()) {
+        anyhow::bail!(
+            "trace file {} exists: results already written are never overwritten; choose another --trace",
+            trace.display()
+        );
+    }
     let bar = progress_bar(
         config.generations() as u64,
         "{spinner} generation {pos}/{len} [{bar:30}] {msg} elapsed {elapsed} ETA {eta}",
     );
     let pool = psa_sim::ode::thread_pool(args.threads as usize)?;
     let outcome = pool.install(|| {
-        run_evolution(
-            &config,
-            args.preset.name(),
-            args.task,
-            args.seed,
-            &out,
-            &path,
-            |record| {
-                bar.set_position(record.generation as u64);
-                bar.set_message(format!("champion {:.1} %", record.champion));
-            },
-        )
+        let on_generation = |record: &GenerationRecord| {
+            bar.set_position(record.generation as u64);
+            bar.set_message(format!("champion {:.1} %", record.champion));
+        };
+        let (label, task, seed) = (args.preset.name(), args.task, args.seed);
+        match &args.trace {
+            Some(trace) => run_evolution_traced(&config, label, task, seed, &out, &path, trace, on_generation),
+            None => run_evolution(&config, label, task, seed, &out, &path, on_generation),
+        }
     })?;
     bar.finish_and_clear();
     if args.json {

@@ -128,6 +128,45 @@ impl State {
     }
 }
 
+impl Credit {
+    /// Each neuron's credit from a generation's networks and their
+    /// fitness: neuron k of sub-population i at index `i subpop_size + k`,
+    /// `None` for a neuron that joined no network. `picks` gives each
+    /// network's neuron of every sub-population ([`Asked::picks`](crate::Asked::picks)),
+    /// in the order of `fitness`. The credit ESP ranks and breeds by; each
+    /// neuron's sum is taken in network order.
+    pub fn neuron_credits<'p>(
+        self,
+        subpops: usize,
+        subpop_size: usize,
+        picks: impl IntoIterator<Item = &'p [usize]>,
+        fitness: &[f64],
+    ) -> Vec<Option<f64>> {
+        let n = subpop_size;
+        let neurons = n * subpops;
+        let (mut sum, mut count, mut max) = (
+            vec![0.0; neurons],
+            vec![0usize; neurons],
+            vec![f64::NEG_INFINITY; neurons],
+        );
+        for (pick, &f) in picks.into_iter().zip(fitness) {
+            for (i, &k) in pick.iter().enumerate() {
+                let j = i * n + k;
+                sum[j] += f;
+                count[j] += 1;
+                max[j] = max[j].max(f);
+            }
+        }
+        (0..neurons)
+            .map(|j| match (count[j], self) {
+                (0, _) => None,
+                (c, Credit::Mean) => Some(sum[j] / c as f64),
+                (_, Credit::Max) => Some(max[j]),
+            })
+            .collect()
+    }
+}
+
 impl Esp {
     /// Which neuron of each sub-population every network takes.
     pub(super) fn sample(&self, generation: usize, subpops: usize) -> Picks {
@@ -164,29 +203,10 @@ impl Esp {
     /// fitness leaves the order as it is.
     pub(super) fn assign_credit(&self, state: &mut State, picks: &Picks, fitness: &[f64]) {
         let n = self.settings.subpop_size;
-        // Neuron k of sub-population i at index i n + k; one pass over the
-        // networks, each neuron's sum in network order.
-        let neurons = n * state.subpops.len();
-        let (mut sum, mut count, mut max) = (
-            vec![0.0; neurons],
-            vec![0usize; neurons],
-            vec![f64::NEG_INFINITY; neurons],
-        );
-        for (pick, &f) in picks.networks().zip(fitness) {
-            for (i, &k) in pick.iter().enumerate() {
-                let j = i * n + k;
-                sum[j] += f;
-                count[j] += 1;
-                max[j] = max[j].max(f);
-            }
-        }
-        let credit: Vec<Option<f64>> = (0..neurons)
-            .map(|j| match (count[j], self.settings.credit) {
-                (0, _) => None,
-                (c, Credit::Mean) => Some(sum[j] / c as f64),
-                (_, Credit::Max) => Some(max[j]),
-            })
-            .collect();
+        let credit = self
+            .settings
+            .credit
+            .neuron_credits(state.subpops.len(), n, picks.networks(), fitness);
         let mut order = Vec::with_capacity(n);
         for (subpop, credit) in state.subpops.iter_mut().zip(credit.chunks_exact(n)) {
             order.clear();

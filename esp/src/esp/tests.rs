@@ -739,3 +739,36 @@ fn stagnation_follows_the_phase_best_or_the_all_time_best() {
     assert_eq!(bursts_for(StagnationRule::PhaseBest, &rising), [6, 10]);
     assert_eq!(bursts_for(StagnationRule::AllTimeBest, &rising), [6, 10]);
 }
+
+#[test]
+fn an_ask_gives_each_network_s_picks_and_credit_follows_them() {
+    use crate::AskTell as _;
+    let e = esp(EspSettings {
+        subpop_size: 4,
+        ..EspSettings::hoverstad()
+    });
+    let credit = Credit::Mean.neuron_credits(
+        1,
+        4,
+        [&[1usize][..], &[1], &[2], &[2], &[0]],
+        &[9.0, 0.0, 5.0, 5.0, 1.0],
+    );
+    assert_eq!(credit, [Some(1.0), Some(4.5), Some(5.0), None]);
+    let credit = Credit::Max.neuron_credits(
+        1,
+        4,
+        [&[1usize][..], &[1], &[2], &[2], &[0]],
+        &[9.0, 0.0, 5.0, 5.0, 1.0],
+    );
+    assert_eq!(credit, [Some(1.0), Some(9.0), Some(5.0), None]);
+
+    // A generation's picks name the neurons its networks are made of.
+    let mut run = e.start(2, 1).unwrap();
+    let asked = run.ask().unwrap().unwrap();
+    assert!(matches!(asked.purpose(), crate::AskPurpose::Generation(1)));
+    let picks = e.sample(1, e.settings.initial_hidden);
+    for (j, expected) in picks.networks().enumerate() {
+        assert_eq!(asked.picks(j), Some(expected));
+    }
+    assert_eq!(asked.picks(picks.count()), None);
+}
