@@ -15,7 +15,7 @@ use psa_sim::psa::{PsaSettings, Task, TrialRecord, TrialRunner};
 
 /// The key of the stream a traced network's trial is flown with (task 2
 /// draws nothing from it: no random start, no noise in evolution).
-const TRACE_TRIAL: u64 = 0x7472_6163_65;
+const TRACE_TRIAL: u64 = 0x0074_7261_6365;
 
 /// How a network's trial passes the scoring window (the steps that earn
 /// points on the scoring fitness: for task 2's original fitness, in the
