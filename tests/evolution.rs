@@ -251,7 +251,7 @@ fn a_traced_evolve_is_the_untraced_run_and_traces_every_generation() {
             "--seed".into(),
             "5".into(),
             "--generations".into(),
-            "40".into(),
+            "80".into(),
             "--config".into(),
             config.clone(),
             "--out".into(),
@@ -272,10 +272,11 @@ fn a_traced_evolve_is_the_untraced_run_and_traces_every_generation() {
     assert!(traced == run("plain", None), "tracing changed the run");
     let text = std::fs::read_to_string(&trace).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines.len(), 41, "{text}");
+    assert_eq!(lines.len(), 81, "{text}");
     assert!(lines[0].starts_with("generation,max,champion,subpops,burst,topology,top_first_pass"));
     // The trace's max and champion are the records' own, and bursts and
-    // topology changes show (stagnation 3 in 40 generations).
+    // topology changes show (stagnation 3 in 80 generations: 8 bursts, 2
+    // topology changes).
     let records = String::from_utf8(traced.0).unwrap();
     for (t, r) in lines[1..].iter().zip(records.lines().skip(1)) {
         let (t, r): (Vec<&str>, Vec<&str>) = (t.split(',').collect(), r.split(',').collect());
