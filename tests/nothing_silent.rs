@@ -546,21 +546,7 @@ fn a_rescoring_setting_that_changes_no_test_is_refused_naming_it() {
         ("[problem]\nrandom_init = true\n", "problem.random_init"),
         ("[problem.fitness]\nkind = \"original\"\n", "problem.fitness.kind"),
     ] {
-        let config = dir.path().join("rescore.toml");
-        std::fs::write(&config, toml).unwrap();
-        let out = dir.path().join("rescored");
-        refused(
-            &psa_esp(&[
-                "rescore",
-                source.to_str().unwrap(),
-                "--config",
-                config.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ]),
-            &[key, "changes nothing"],
-        );
-        assert!(!out.exists(), "{key}: nothing written");
+        rescore_is_refused_as_changing_nothing(dir.path(), &source, toml, key);
     }
 }
 
@@ -957,21 +943,7 @@ fn a_rescoring_setting_no_task_of_the_grid_reads_is_refused_naming_it() {
         ),
         ("[problem.task2]\nsteps = 100\n", "problem.task2.steps"),
     ] {
-        let config = dir.path().join("rescore.toml");
-        std::fs::write(&config, toml).unwrap();
-        let out = dir.path().join("rescored");
-        refused(
-            &psa_esp(&[
-                "rescore",
-                source.to_str().unwrap(),
-                "--config",
-                config.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-            ]),
-            &[key, "changes nothing"],
-        );
-        assert!(!out.exists(), "{key}: nothing written");
+        rescore_is_refused_as_changing_nothing(dir.path(), &source, toml, key);
     }
 }
 
@@ -1171,4 +1143,24 @@ fn evolve_refuses_a_folder_name_that_is_not_utf8() {
         .unwrap();
     refused(&o, &["not UTF-8"]);
     assert!(!out.exists());
+}
+
+/// Rescores the grid `source` with the settings `toml` into a folder in
+/// `dir`: refused, naming `key` as changing nothing, and nothing written.
+fn rescore_is_refused_as_changing_nothing(dir: &Path, source: &Path, toml: &str, key: &str) {
+    let config = dir.join("rescore.toml");
+    std::fs::write(&config, toml).unwrap();
+    let out = dir.join("rescored");
+    refused(
+        &psa_esp(&[
+            "rescore",
+            source.to_str().unwrap(),
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]),
+        &[key, "changes nothing"],
+    );
+    assert!(!out.exists(), "{key}: nothing written");
 }
