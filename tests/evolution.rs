@@ -327,3 +327,101 @@ fn a_traced_evolve_is_the_untraced_run_and_traces_every_generation() {
         "{o:?}"
     );
 }
+
+/// A trace with the given generations' best networks landing (1-based),
+/// a burst ending generation 3, mean-credit ranks 0.2 (landing) and 0.6.
+fn handmade_trace(generations: usize, landing: &[usize]) -> String {
+    let mut text = String::from(
+        "generation,max,champion,subpops,burst,topology,top_first_pass,top_entries,top_steps_in,top_first_in,\
+         champion_first_pass,mean_credit_rank,max_credit_rank,mean_credit_gap\n",
+    );
+    let first = landing.iter().min().copied().unwrap_or(usize::MAX);
+    for g in 1..=generations {
+        let lands = landing.contains(&g);
+        text.push_str(&format!(
+            "{g},50,50,5,{},,{},1,10,490,{},{},0,0.1\n",
+            u8::from(g == 3),
+            u8::from(lands),
+            u8::from(g >= first),
+            if lands { "0.2000" } else { "0.6000" },
+        ));
+    }
+    text
+}
+
+#[test]
+fn traces_summarises_each_folder_of_traces_as_a_group() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = small_config(dir.path());
+    // Group "real": one trace written by evolve; group "made": two of known content.
+    let real = dir.path().join("real");
+    let made = dir.path().join("made");
+    std::fs::create_dir_all(&real).unwrap();
+    std::fs::create_dir_all(&made).unwrap();
+    let o = psa_esp(&[
+        "evolve",
+        "--task",
+        "2",
+        "--generations",
+        "20",
+        "--config",
+        &config,
+        "--out",
+        dir.path().join("run").to_str().unwrap(),
+        "--trace",
+        real.join("seed-1.trace.csv").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Lands at 3 (lost at the burst), 5-6 (lost otherwise) and 8 (the last).
+    std::fs::write(made.join("a.trace.csv"), handmade_trace(8, &[3, 5, 6, 8])).unwrap();
+    std::fs::write(made.join("b.trace.csv"), handmade_trace(8, &[])).unwrap();
+    std::fs::write(made.join("notes.txt"), "not a trace").unwrap();
+    let out = dir.path().join("summary");
+    let o = psa_esp(&[
+        "traces",
+        real.to_str().unwrap(),
+        made.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        table.contains("| made | 2 | 1 | 3 | 4 | 1 / 0 / 1 | 1 | 0.20 / 0.60 |"),
+        "{table}"
+    );
+    assert!(table.lines().any(|l| l.starts_with("| real | 1 |")), "{table}");
+    assert_eq!(std::fs::read_to_string(out.join("traces.md")).unwrap(), table);
+    let csv = std::fs::read_to_string(out.join("traces.csv")).unwrap();
+    assert!(csv.contains("\nmade,a,8,3,4,1,0,1,1,0.2000,0.6000\n"), "{csv}");
+    assert!(csv.contains("\nmade,b,8,,0,0,0,0,0,,0.6000\n"), "{csv}");
+    assert_eq!(
+        csv.lines().filter(|l| l.starts_with("real,seed-1,20,")).count(),
+        1,
+        "{csv}"
+    );
+    for figure in ["traces-landing.svg", "traces-landing.png"] {
+        assert!(std::fs::metadata(out.join(figure)).unwrap().len() > 1000, "{figure}");
+    }
+
+    // A folder without traces, and a damaged trace, are refused by name.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = psa_esp(&["traces", empty.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("empty") && stderr.contains("no *.trace.csv"),
+        "{stderr}"
+    );
+    std::fs::write(
+        made.join("c.trace.csv"),
+        handmade_trace(3, &[]).replace("\n2,50,50,5,0,,0,", "\n2,50,50,5,0,,2,"),
+    )
+    .unwrap();
+    let o = psa_esp(&["traces", made.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("c.trace.csv line 3") && stderr.contains("top_first_pass"),
+        "{stderr}"
+    );
+}

@@ -25,6 +25,7 @@ mod report;
 mod rescore;
 mod simulate;
 mod sweep;
+mod traces;
 
 use clap::{Parser, Subcommand};
 
@@ -61,6 +62,8 @@ pub enum Command {
     Rescore(rescore::RescoreArgs),
     /// Fly a saved network on a task: fitness, trajectory CSV, pictures, animation.
     Replay(replay::ReplayArgs),
+    /// Summarise `evolve --trace` files, a group per folder: when runs first find a first-pass landing, how often they lose it, how mean credit ranks its neurons.
+    Traces(traces::TracesArgs),
     /// Measure physics steps and network evaluations of every backend in one run.
     Bench(bench::BenchArgs),
 }
@@ -76,6 +79,7 @@ pub fn run(cli: Cli) -> anyhow::Result<i32> {
         Command::Report(args) => report::run(args),
         Command::Rescore(args) => rescore::run(args),
         Command::Replay(args) => replay::run(args),
+        Command::Traces(args) => traces::run(args),
         Command::Bench(args) => bench::run(args),
     }
 }

@@ -1,9 +1,12 @@
 //! A traced ESP run: the same run, bit for bit, driven by ask and tell,
 //! with a line per generation on its best network: whether it is a
 //! first-pass landing (flown once on the scoring fitness) and how ESP's
-//! credit ranks its neurons within their sub-populations.
+//! credit ranks its neurons within their sub-populations; [`summary`]
+//! reads traces back and summarises them.
 
 use std::path::Path;
+
+pub mod summary;
 
 use anyhow::{bail, Result};
 use esp_neuroevolution::network::{Network, NetworkSet as _};
