@@ -161,6 +161,23 @@ fn the_task2_towards_target_file_repeats_the_records_of_the_refit_byte_for_byte(
     );
 }
 
+#[test]
+fn the_clockwise_start_file_repeats_the_records_of_sweeps_s33_to_s35_byte_for_byte() {
+    // Recorded by build 8360a43, whose defaults the file pins: the sensor
+    // scales 10, 10, 1, 1 and task 2 starting at -1.5 rad/s.
+    let config = "configs/clockwise-start.toml";
+    assert_repeats_the_golden_records(config, "clockwise-start", &["baseline", "max-credit"]);
+    // Today's defaults scale the inputs by half and start task 2 at
+    // -0.75 rad/s: every task flies another run.
+    for task in ["1", "2", "3"] {
+        let recorded = std::fs::read(repo(&format!("tests/golden/clockwise-start/baseline-t{task}.csv"))).unwrap();
+        assert!(
+            golden_run_records(None, "baseline", task) != recorded,
+            "task {task}: the defaults did not move"
+        );
+    }
+}
+
 /// The `records.csv` of the golden records' run (seed 7, 120 generations,
 /// native) of `preset` on `task`, with `config` laid over it if given.
 fn golden_run_records(config: Option<&Path>, preset: &str, task: &str) -> Vec<u8> {

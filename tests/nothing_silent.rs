@@ -1017,7 +1017,7 @@ fn report_md_lists_every_setting_a_grid_changes_from_the_defaults() {
     ok(&psa_esp(&["report", grid.to_str().unwrap()]));
     let md = std::fs::read_to_string(grid.join("report.md")).unwrap();
     assert!(
-        md.contains("`problem.tasks.task2_spin = 1.0` (default -1.5)"),
+        md.contains("`problem.tasks.task2_spin = 1.0` (default -0.75)"),
         "report.md should name the setting: {md}"
     );
 }

@@ -297,7 +297,7 @@ fn start_states_and_targets_are_as_specified() {
         (
             BodyState {
                 // Clockwise, away from the target heading.
-                omega: -1.5,
+                omega: -0.75,
                 ..BodyState::default()
             },
             Target {

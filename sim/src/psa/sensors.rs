@@ -61,17 +61,21 @@ pub enum NoiseStage {
     Raw,
 }
 
-/// Input scaling (`[chosen]` values; the paper's inputs were O(1) or larger).
+/// Input scaling: one factor, `[fitted]` 0.5, on the scales 10 per m, 10
+/// per m/s, 1 per rad and 1 per rad/s (docs/sweeps/s04-sensor-scaling.md,
+/// s39-sensor-scales.md, s41-s44-one-factor-and-task2-start.md); the
+/// inputs then lie about 1 to 3, the noise (sd 0.05) one and a half to
+/// two orders of magnitude below them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSettings {
-    /// Input units per metre of position relative to the target. `[chosen]` 10
+    /// Input units per metre of position relative to the target. `[fitted]` 5
     pub position_scale: f64,
-    /// Input units per m/s of velocity. `[chosen]` 10
+    /// Input units per m/s of velocity. `[fitted]` 5
     pub velocity_scale: f64,
-    /// Input units per radian of heading error. `[chosen]` 1
+    /// Input units per radian of heading error. `[fitted]` 0.5
     pub heading_scale: f64,
-    /// Input units per rad/s of angular velocity. `[chosen]` 1
+    /// Input units per rad/s of angular velocity. `[fitted]` 0.5
     pub angular_velocity_scale: f64,
     /// The constant bias input. `[chosen]` 1
     pub bias: f64,
@@ -85,10 +89,10 @@ pub struct SensorSettings {
 impl Default for SensorSettings {
     fn default() -> Self {
         SensorSettings {
-            position_scale: 10.0,
-            velocity_scale: 10.0,
-            heading_scale: 1.0,
-            angular_velocity_scale: 1.0,
+            position_scale: 5.0,
+            velocity_scale: 5.0,
+            heading_scale: 0.5,
+            angular_velocity_scale: 0.5,
             bias: 1.0,
             heading_input: HeadingInput::Error,
             heading_wrap: HeadingWrap::default(),

@@ -136,10 +136,11 @@ pub struct TaskSettings {
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
     /// Task 2: initial spin (rad/s, anticlockwise positive): the PSA is
-    /// turning when the trial starts. `[fitted]` -1.5, clockwise, away from
-    /// the target: the whole distance to the paper (Table 1 and 2 for task
-    /// 2 with their spreads, the burst totals and their ratio;
-    /// docs/sweeps/s24-s33-s35-task2-start.md)
+    /// turning when the trial starts. `[fitted]` -0.75, clockwise, away
+    /// from the target: the whole distance to the paper (Table 1 and 2 for
+    /// task 2 with their spreads, the burst totals and their ratio), fitted
+    /// with the sensor scales (docs/sweeps/s41-s44-one-factor-and-task2-start.md;
+    /// no source gives task 2's start)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
@@ -162,7 +163,7 @@ impl Default for TaskSettings {
         TaskSettings {
             task1_spin: 1.0,
             task2_target_heading: FRAC_PI_2,
-            task2_spin: -1.5,
+            task2_spin: -0.75,
             task2_velocity: [0.0, 0.0],
             task3_speed: 0.4,
             task3_distance: 0.40,

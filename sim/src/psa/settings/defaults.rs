@@ -108,6 +108,15 @@ pub const CHANGES: &[Change] = &[
     changed("hill_climb.alpha", "", "0.3"),
     changed("problem.tasks.task2_spin", "", "-1.5"),
     first("problem.noise.stage", r#""scaled""#),
+    changed("problem.tasks.task2_spin", "", "-0.75"),
+    first("problem.sensors.position_scale", "10.0"),
+    changed("problem.sensors.position_scale", "", "5.0"),
+    first("problem.sensors.velocity_scale", "10.0"),
+    changed("problem.sensors.velocity_scale", "", "5.0"),
+    first("problem.sensors.heading_scale", "1.0"),
+    changed("problem.sensors.heading_scale", "", "0.5"),
+    first("problem.sensors.angular_velocity_scale", "1.0"),
+    changed("problem.sensors.angular_velocity_scale", "", "0.5"),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.
