@@ -154,6 +154,7 @@ mod tests {
     #[test]
     fn the_heading_input_is_the_error_or_the_heading_in_its_wrap_range() {
         let mut s = Settings::default();
+        s.sensors.heading_scale = 1.0;
         s.sensors.heading_wrap = HeadingWrap::Symmetric;
         let target = [0.0, 0.0, 1.0];
         // The error: heading -3 against target 1 is -4, wrapped to 2 pi - 4.
@@ -220,7 +221,9 @@ mod tests {
         // The normal numbers the source draws, in the inputs' order.
         let mut draws = [0.0; INPUT_COUNT];
         NoiseSource::new(11).add_scaled(&mut draws, 1.0);
-        let scales = [10.0, 10.0, 10.0, 10.0, 2.0, 1.0];
+        let sensors = s.sensors;
+        let (p, v) = (sensors.position_scale, sensors.velocity_scale);
+        let scales = [p, p, v, v, 2.0, sensors.angular_velocity_scale];
         let measured = [offset[0], offset[1], velocity[0], velocity[1], heading, omega];
         let scaled = read(&s);
         s.noise.stage = NoiseStage::Raw;
@@ -246,6 +249,9 @@ mod tests {
     #[test]
     fn the_sensed_fitness_reads_the_inputs_over_their_scales() {
         let mut s = Settings::default();
+        s.sensors.position_scale = 10.0;
+        s.sensors.heading_scale = 1.0;
+        s.sensors.angular_velocity_scale = 1.0;
         s.fitness.state = FitnessState::True;
         let target = [0.0, 0.0, 0.0];
         let before = clean_reading(&s, 0.0, target);
