@@ -233,9 +233,12 @@ fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
     let net_path = dir.path().join("damper.json");
     // The damper is made for task 1's earlier start spin of 1 rad/s (at the
     // default 2 rad/s its full thrust pushes the PSA out of the box before
-    // the spin stops); the file records that model, and replay flies on it.
+    // the spin stops) and for a spin input of 1 per rad/s (its weights of
+    // 20 saturate the braking neurons; the default scale halves them); the
+    // file records that model, and replay flies on it.
     let mut model = PsaSettings::default();
     model.tasks.task1_spin = 1.0;
+    model.sensors.angular_velocity_scale = 1.0;
     NetworkFile::new(
         &spin_damper(),
         Task::StopRotation,

@@ -4,7 +4,7 @@
 //! or `start.*` for the start state `simulate --start` takes), its range and
 //! why; a sensible experiment never leaves it (a real PSA is a softball- to
 //! volleyball-sized robot with 1 N thrusters; the paper's tasks start with
-//! spins of 1 to 1.5 rad/s and speeds of up to 0.4 m/s and step at 0.05 s).
+//! spins of 0.75 to 1 rad/s and speeds of up to 0.4 m/s and step at 0.05 s).
 //! Settings are checked against it when a configuration or the command line
 //! is read, with an error naming the key, the value and the range. Within
 //! these ranges no trial comes near what the physics engines cannot
@@ -48,11 +48,11 @@ const SPEED_WHY: &str = "the tasks start at up to 0.4 m/s, the fastest flight mo
 /// Angular velocities (rad/s).
 const SPIN: [f64; 2] = [-100.0, 100.0];
 const SPIN_WHY: &str =
-    "the start spins fitted to the paper are 1 to 1.5 rad/s either way; 100 rad/s is 16 turns a second";
+    "the start spins fitted to the paper are 0.75 to 1 rad/s either way; 100 rad/s is 16 turns a second";
 /// Input scalings (input units per SI unit) and the bias input.
 const SCALE: [f64; 2] = [-1000.0, 1000.0];
 const SCALE_WHY: &str =
-    "network inputs of O(1) (defaults 1-10 per SI unit); far beyond, every input saturates the sigmoid";
+    "network inputs of O(1) (defaults 0.5-5 per SI unit, the bias 1); far beyond, every input saturates the sigmoid";
 
 const fn row(key: &'static str, range: [f64; 2], unit: &'static str, reason: &'static str) -> Limit {
     Limit {
