@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, ensure, Context, Result};
 
 use crate::plots::curves::{write_curve_figure, CurveFigure, Series};
+use crate::results::stats::mean_sd;
 use psa_sim::io::write_atomic;
 
 /// The file name ending that marks a trace in a group's folder.
@@ -113,9 +114,10 @@ pub struct RunSummary {
     pub other_rank: Option<f64>,
 }
 
+/// The mean of `values` ([`mean_sd`]'s), if there is any.
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    (n > 0).then(|| sum / n as f64)
+    let values: Vec<f64> = values.collect();
+    (!values.is_empty()).then(|| mean_sd(&values).0)
 }
 
 impl RunSummary {
@@ -226,7 +228,8 @@ impl Group {
     }
 }
 
-fn median(mut values: Vec<usize>) -> Option<f64> {
+fn median(values: &[usize]) -> Option<f64> {
+    let mut values = values.to_vec();
     values.sort_unstable();
     let n = values.len();
     (n > 0).then(|| {
@@ -259,7 +262,7 @@ pub fn summary_markdown(groups: &[Group]) -> String {
             g.name,
             runs.len(),
             found.len(),
-            or_dash(median(found.clone()), 0),
+            or_dash(median(&found), 0),
             sum(|r| r.landing_generations),
             sum(|r| r.lost_after_burst),
             sum(|r| r.lost_after_topology),
@@ -405,7 +408,7 @@ mod tests {
         };
         assert_eq!(group.found_by(), [(1.0, 0.0), (2.0, 50.0), (3.0, 50.0), (4.0, 75.0)]);
         assert_eq!(group.landing_at(), [(1.0, 0.0), (2.0, 50.0), (3.0, 25.0), (4.0, 0.0)]);
-        assert_eq!(median(vec![4, 2, 2]), Some(2.0));
-        assert_eq!(median(vec![]), None);
+        assert_eq!(median(&[4, 2, 2]), Some(2.0));
+        assert_eq!(median(&[]), None);
     }
 }
