@@ -64,8 +64,8 @@ pub enum NoiseStage {
 /// Input scaling: one factor, `[fitted]` 0.5, on the scales 10 per m, 10
 /// per m/s, 1 per rad and 1 per rad/s (docs/sweeps/s04-sensor-scaling.md,
 /// s39-sensor-scales.md, s41-s44-one-factor-and-task2-start.md); the
-/// inputs then lie about 1 to 3, the noise (sd 0.05) one and a half to
-/// two orders of magnitude below them.
+/// inputs then lie about 0.75 to 3 (the box's 0.2 m, 0.4 m/s, a heading
+/// error of up to 2 pi, 1.5 rad/s), 15 to 60 times the noise (sd 0.05).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSettings {
