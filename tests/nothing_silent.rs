@@ -430,6 +430,7 @@ fn grid(configs: &[&str], tasks: &[Task]) -> GridSpec {
         configs: configs.iter().map(|c| c.parse().unwrap()).collect(),
         tasks: tasks.to_vec(),
         seeds: 1,
+        first_seed: 1,
         generations: 3,
         robustness_trials: 3,
         ..GridSpec::from_preset(GridPreset::Quick)

@@ -487,3 +487,70 @@ fn a_sweep_in_lockstep_advances_every_variant_in_one_pass_to_the_files_of_run_by
         "the lockstep sweep differs from the run-by-run one"
     );
 }
+
+#[test]
+fn a_first_seed_grid_runs_the_seeds_of_a_larger_grid_byte_for_byte_and_extends_a_grid_at_its_end() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (whole, part, joined) = (
+        tmp.path().join("whole"),
+        tmp.path().join("part"),
+        tmp.path().join("joined"),
+    );
+    let with_first = |args: [&str; 13], first: &str| {
+        let mut v = args.to_vec();
+        v.splice(1..1, ["--first-seed", first]);
+        v.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let run = |args: &[String]| {
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        psa_esp(&refs)
+    };
+    assert!(psa_esp(&tiny_baseline_grid("1", "4", &whole)).status.success());
+    let o = run(&with_first(tiny_baseline_grid("1", "2", &part), "3"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Seeds 3 and 4 of the larger grid, byte for byte, under their own names.
+    let part_files = results(&part);
+    assert_eq!(part_files.len(), 2 * 4);
+    let whole_files = results(&whole);
+    for (path, bytes) in &part_files {
+        assert!(path.contains("seed3") || path.contains("seed4"), "{path}");
+        let same = whole_files.iter().find(|(p, _)| p == path).unwrap();
+        assert!(&same.1 == bytes, "{path} differs from the larger grid's");
+    }
+    let grid: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(part.join("grid.json")).unwrap()).unwrap();
+    assert_eq!(grid["first_seed"], 3);
+    let o = psa_esp(&["report", part.to_str().unwrap()]);
+    assert!(o.status.success());
+    let md = std::fs::read_to_string(part.join("report.md")).unwrap();
+    assert!(md.contains("| seeds | 3 to 4 per configuration and task |"), "{md}");
+    // Resuming needs the same first seed: without it, refused and named.
+    let o = psa_esp(&tiny_baseline_grid("1", "2", &part));
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("seeds 1 to 2") && err.contains("--first-seed 5"), "{err}");
+    // A grid of seeds 1-2 extended by seeds 3-4 in one command: the files of seeds 1-4.
+    assert!(psa_esp(&tiny_baseline_grid("1", "2", &joined)).status.success());
+    let o = run(&with_first(tiny_baseline_grid("1", "2", &joined), "3"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(results(&joined) == whole_files);
+    assert_eq!(
+        std::fs::read(joined.join("grid.json")).unwrap(),
+        std::fs::read(whole.join("grid.json")).unwrap()
+    );
+    // Seeds that overlap a grid's only in part, or would pass the largest seed, are refused.
+    let o = run(&with_first(tiny_baseline_grid("1", "3", &joined), "3"));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("clash"));
+    let o = run(&with_first(
+        tiny_baseline_grid("1", "2", &tmp.path().join("far")),
+        &u64::MAX.to_string(),
+    ));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("largest seed"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(!tmp.path().join("far").exists());
+}

@@ -124,6 +124,7 @@ pub fn replicate_workload(generations: usize) -> Result<Workload> {
             GridConfig::Preset(Preset::MaxCredit),
         ],
         seeds: 2,
+        first_seed: 1,
         generations,
         backend: BackendKind::Native,
         robustness_trials: 50,

@@ -51,9 +51,15 @@ pub struct GridArgs {
     /// Tasks, comma-separated (default: 1,2,3).
     #[arg(long, value_delimiter = ',')]
     pub tasks: Option<Vec<Task>>,
-    /// Seeds per configuration and task (seeds 1..=N, at most 10,000).
+    /// Seeds per configuration and task (seeds F to F+N-1 with F the
+    /// --first-seed, at most 10,000).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_SEEDS))]
     pub seeds: Option<u64>,
+    /// The first seed (default 1): `--first-seed 31 --seeds 30` runs seeds
+    /// 31 to 60, the same runs as seeds 31 to 60 of a larger grid. On an
+    /// existing grid whose seeds end at F-1 it adds these seeds to it.
+    #[arg(long, value_name = "F", value_parser = clap::value_parser!(u64).range(1..))]
+    pub first_seed: Option<u64>,
     /// Generations (ESP) or cycles (hill-climber) per run (at most 1,000,000).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_GENERATIONS as u64))]
     pub generations: Option<u64>,
@@ -133,6 +139,7 @@ impl GridArgs {
             spec.tasks = t.clone();
         }
         spec.seeds = self.seeds.unwrap_or(spec.seeds);
+        spec.first_seed = self.first_seed.unwrap_or(spec.first_seed);
         spec.generations = self.generations.map_or(spec.generations, |g| g as usize);
         spec.backend = self.backend.map_or(spec.backend, BackendArg::physics);
         spec.robustness_trials = self.robustness_trials.map_or(spec.robustness_trials, |t| t as usize);

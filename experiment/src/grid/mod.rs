@@ -95,8 +95,12 @@ pub struct GridSpec {
     pub configs: Vec<GridConfig>,
     /// The tasks.
     pub tasks: Vec<Task>,
-    /// Seeds 1..=seeds.
+    /// How many seeds: seeds `first_seed..first_seed + seeds`.
     pub seeds: u64,
+    /// The first seed (1 when absent: every grid of an earlier build);
+    /// written only when it is not 1, so such a grid.json reads as before.
+    #[serde(default = "first_seed_one", skip_serializing_if = "is_first_seed_one")]
+    pub first_seed: u64,
     /// Generations (ESP) or cycles (hill-climber) per run.
     pub generations: usize,
     /// Physics backend.
@@ -118,6 +122,16 @@ pub struct GridSpec {
     /// document): a grid re-scored by `psa-esp rescore`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rescoring: Option<String>,
+}
+
+/// The first seed of a grid that names none.
+fn first_seed_one() -> u64 {
+    1
+}
+
+/// Whether `first_seed` is the one a grid.json may leave out.
+fn is_first_seed_one(first_seed: &u64) -> bool {
+    *first_seed == 1
 }
 
 /// The folder status of one run.
@@ -157,6 +171,7 @@ impl GridSpec {
             configs: GridConfig::all().into_iter().filter(|c| c.in_paper()).collect(),
             tasks: Task::VARIANTS.iter().copied().filter(|t| t.in_paper()).collect(),
             seeds,
+            first_seed: 1,
             generations,
             backend,
             robustness_trials,
@@ -191,6 +206,17 @@ impl GridSpec {
             if !(1..=max).contains(&value) {
                 bail!("{name} must be in [1, {max}], got {value}");
             }
+        }
+        if self.first_seed == 0 {
+            bail!("first_seed must be at least 1 (seeds are numbered from 1), got 0");
+        }
+        if self.first_seed.checked_add(self.seeds - 1).is_none() {
+            bail!(
+                "first_seed {} with {} seeds would pass the largest seed, {}",
+                self.first_seed,
+                self.seeds,
+                u64::MAX
+            );
         }
         if !self.backend.is_available() {
             bail!("backend {} is not available in this build", self.backend);
@@ -264,12 +290,23 @@ impl GridSpec {
                 if !config.applies_to(task) || self.tasks[..j].contains(&task) {
                     continue;
                 }
-                for seed in 1..=self.seeds {
+                for seed in self.seed_range() {
                     runs.push(RunKey { config, task, seed });
                 }
             }
         }
         runs
+    }
+
+    /// The grid's seeds, `first_seed` to `first_seed + seeds - 1` (valid
+    /// grids only: [`GridSpec::validate`] refuses a range past `u64::MAX`).
+    pub fn seed_range(&self) -> std::ops::RangeInclusive<u64> {
+        self.first_seed..=self.first_seed.saturating_add(self.seeds.saturating_sub(1))
+    }
+
+    /// The seeds in words: "1 to 30".
+    pub fn seeds_label(&self) -> String {
+        format!("{} to {}", self.seed_range().start(), self.seed_range().end())
     }
 
     /// The full configuration a run of `config` uses in this grid.

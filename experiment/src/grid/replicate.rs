@@ -109,11 +109,7 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Resul
     } else {
         let existing = GridSpec::load(dir)?;
         if existing != *spec {
-            bail!(
-                "{} holds a grid with another definition ({}); resume it with the same options or use another --out",
-                dir.display(),
-                describe(&existing)
-            );
+            extend_seeds(dir, &existing, spec)?;
         }
     }
     let mut todo = Vec::new();
@@ -152,7 +148,7 @@ pub fn describe(spec: &GridSpec) -> String {
         "configs {}, tasks {}, seeds {}, {} generations, backend {}{}, {} robustness trials",
         configs.join(","),
         tasks.join(","),
-        spec.seeds,
+        spec.seeds_label(),
         spec.generations,
         spec.backend,
         if spec.ode_check {
@@ -162,6 +158,59 @@ pub fn describe(spec: &GridSpec) -> String {
         },
         spec.robustness_trials
     )
+}
+
+/// A grid `spec` that differs from the `existing` one in `dir` only in its
+/// seeds: a range inside the existing one resumes those runs; a range
+/// that starts right after it extends the grid (grid.json rewritten with
+/// the two ranges joined), so that adding seeds to a finished grid is one
+/// command (`--first-seed 31 --seeds 30` on a grid of seeds 1 to 30).
+/// Anything else is refused: another definition, seeds that overlap the
+/// existing ones only in part, or that leave a gap or lie before them (a
+/// grid's seeds are one range; a forgotten `--first-seed` never extends a
+/// grid backwards).
+fn extend_seeds(dir: &Path, existing: &GridSpec, spec: &GridSpec) -> Result<()> {
+    let refuse = |why: String| -> Result<()> {
+        bail!(
+            "{} holds a grid with another definition ({}){why}; resume it with the same options or use another --out",
+            dir.display(),
+            describe(existing)
+        )
+    };
+    let seeds_only = GridSpec {
+        seeds: existing.seeds,
+        first_seed: existing.first_seed,
+        ..spec.clone()
+    };
+    if seeds_only != *existing {
+        return refuse(String::new());
+    }
+    let (old, new) = (existing.seed_range(), spec.seed_range());
+    if old.contains(new.start()) && old.contains(new.end()) {
+        return Ok(());
+    }
+    let overlaps = new.start() <= old.end() && old.start() <= new.end();
+    if overlaps {
+        return refuse(format!(
+            ": seeds {} clash with its seeds {} (a grid's seeds are one range: extend it with seeds right after or before its own)",
+            spec.seeds_label(),
+            existing.seeds_label()
+        ));
+    }
+    if old.end().checked_add(1) != Some(*new.start()) {
+        return refuse(format!(
+            ": seeds {} do not start right after its seeds {} (a grid's seeds are one range, extended at its end: --first-seed {})",
+            spec.seeds_label(),
+            existing.seeds_label(),
+            old.end().saturating_add(1)
+        ));
+    }
+    let joined = GridSpec {
+        seeds: existing.seeds + spec.seeds,
+        ..existing.clone()
+    };
+    joined.validate()?;
+    joined.save(dir)
 }
 
 /// What claiming a run found.

@@ -97,7 +97,8 @@ pub struct SweepSpec {
 }
 
 /// Splits `KEY=V1,V2,...` into the key and its values; commas inside
-/// brackets or quotes belong to the value (`task2_velocity=[0.1,0],[0.2,0]`).
+/// brackets, braces or quotes belong to the value (`task2_velocity=[0.1,0],[0.2,0]`,
+/// `problem.sensors={position_scale=10.0,heading_scale=1.0}`).
 pub fn parse_vary(text: &str) -> Result<Vary> {
     let (key, values) = text
         .split_once('=')
@@ -111,8 +112,8 @@ pub fn parse_vary(text: &str) -> Result<Vary> {
     for c in values.chars() {
         match c {
             '"' => quoted = !quoted,
-            '[' if !quoted => depth += 1,
-            ']' if !quoted => depth -= 1,
+            '[' | '{' if !quoted => depth += 1,
+            ']' | '}' if !quoted => depth -= 1,
             ',' if !quoted && depth == 0 => {
                 parts.push(std::mem::take(&mut current));
                 continue;
@@ -595,6 +596,9 @@ mod tests {
         assert_eq!(v.values, ["\"phase_best\"", "\"all_time_best\""]);
         let v = parse_vary("esp.stagnation=20,40").unwrap();
         assert_eq!(v.values, ["20", "40"]);
+        let v = parse_vary("problem.sensors={position_scale=10.0,heading_scale=1.0},{position_scale=5.0}").unwrap();
+        assert_eq!(v.values.len(), 2, "{:?}", v.values);
+        assert!(v.values[0].contains("heading_scale"));
         assert!(parse_vary("esp.stagnation").is_err());
         assert!(parse_vary("esp.stagnation=20,20").is_err());
         assert!(parse_vary("esp..x=1").is_err());

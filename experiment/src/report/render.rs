@@ -140,7 +140,7 @@ fn grid_section(md: &mut String, report: &Report) {
         ("preset", preset.to_string()),
         ("configurations", configs.join(", ")),
         ("tasks", tasks.join(", ")),
-        ("seeds", format!("1 to {} per configuration and task", g.seeds)),
+        ("seeds", format!("{} per configuration and task", g.seeds_label())),
         ("generations (ESP) / cycles (hill-climbing)", g.generations.to_string()),
         ("physics backend", backend),
         (

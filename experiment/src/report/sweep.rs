@@ -183,11 +183,11 @@ impl SweepReport {
             .collect();
         let _ = writeln!(
             md,
-            "Varied ({:?}): {}. Every variant runs the same grid ({} seeds, {} generations, backend {}); \
+            "Varied ({:?}): {}. Every variant runs the same grid (seeds {}, {} generations, backend {}); \
              `psa-esp report variants/<variant>` gives a variant's full report.\n",
             self.sweep.mode,
             varied.join("; "),
-            self.sweep.grid.seeds,
+            self.sweep.grid.seeds_label(),
             self.sweep.grid.generations,
             self.sweep.grid.backend
         );

@@ -21,6 +21,7 @@ fn spec() -> GridSpec {
         configs: vec![BASELINE, MAX_CREDIT, GridConfig::InputNoise],
         tasks: vec![Task::StopRotation, Task::Turn],
         seeds: 3,
+        first_seed: 1,
         generations: 4,
         backend: BackendKind::Native,
         robustness_trials: 10,
