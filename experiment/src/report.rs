@@ -18,6 +18,7 @@ mod sweep;
 mod tables;
 #[cfg(test)]
 mod tests;
+pub mod uncertainty;
 
 use std::path::{Path, PathBuf};
 

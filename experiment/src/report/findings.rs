@@ -136,6 +136,10 @@ pub struct Finding {
     pub holds_in_paper: bool,
     /// The verdict here.
     pub verdict: Verdict,
+    /// The share of seed resamples of the grid on which the rule gives
+    /// the same verdict ([`super::uncertainty`]); `None` until measured,
+    /// and for a finding not testable here.
+    pub replication: Option<f64>,
 }
 
 impl Finding {
@@ -154,6 +158,7 @@ impl Finding {
             rule,
             holds_in_paper: judge(&paper) == Verdict::Reproduced,
             verdict: judge(&here),
+            replication: None,
             paper,
             here,
         }

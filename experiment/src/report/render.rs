@@ -6,6 +6,7 @@ use super::distance::Distance;
 use super::findings::{Comparison, Finding, Rule, ALPHA, COLLAPSE_FRACTION, DOUBLING_RATIO};
 use super::paper::PAPER_BURST_RUNS;
 use super::tables::{Report, Table};
+use super::uncertainty::{GridUncertainty, Interval, LEVEL};
 use crate::grid::{GridPreset, GridSpec};
 use crate::PAPER_NOISE_SD;
 use psa_sim::named::Named;
@@ -16,6 +17,15 @@ pub(super) fn num(x: f64) -> String {
         "–".into()
     } else {
         format!("{x:.1}")
+    }
+}
+
+/// A value with its interval, one decimal each: "42.4 [37.1, 47.7]"; the
+/// value alone without one.
+pub(super) fn with_interval(x: f64, interval: Option<Interval>) -> String {
+    match interval {
+        Some(i) => format!("{} [{}, {}]", num(x), num(i.lo), num(i.hi)),
+        None => num(x),
     }
 }
 
@@ -61,26 +71,32 @@ pub fn markdown(report: &Report) -> String {
     for table in report.tables.iter().filter(|t| matches!(t.id.as_str(), "2" | "3")) {
         table_md(&mut md, table);
     }
-    distance_md(&mut md, &report.distance);
+    distance_md(&mut md, &report.distance, &report.uncertainty);
     findings_md(&mut md, report);
     figures_md(&mut md, report);
     md
 }
 
-/// The distance to the paper and its terms.
-pub(super) fn distance_md(md: &mut String, distance: &Distance) {
+/// The distance to the paper and its terms, with the intervals of D and
+/// its parts from `uncertainty`.
+pub(super) fn distance_md(md: &mut String, distance: &Distance, uncertainty: &GridUncertainty) {
     md.push_str(
         "## Distance to the paper
 
 ",
     );
+    let d = &uncertainty.distance;
     let _ = writeln!(
         md,
-        "D = {:.1}: the sum of ((here - paper) / se)^2 over Table 1's and Table 2's means and the two burst totals \
-         (the means: {:.1}), the standard deviations of the same cells (the spreads: {:.1}) and max credit's bursts \
-         over the baseline's (the burst ratio: {:.1}); se is the paper's sd / sqrt(30) for a mean, sd / sqrt(58) for \
-         an sd, sqrt(total) for a total (see docs/model.md).\n",
-        distance.total, distance.means, distance.spreads, distance.burst_ratio
+        "D = {}: the sum of ((here - paper) / se)^2 over Table 1's and Table 2's means and the two burst totals \
+         (the means: {}), the standard deviations of the same cells (the spreads: {}) and max credit's bursts \
+         over the baseline's (the burst ratio: {}); se is the paper's sd / sqrt(30) for a mean, sd / sqrt(58) for \
+         an sd, sqrt(total) for a total (see docs/model.md). {}\n",
+        with_interval(distance.total, d.total),
+        with_interval(distance.means, d.means),
+        with_interval(distance.spreads, d.spreads),
+        with_interval(distance.burst_ratio, d.burst_ratio),
+        resampling_note(uncertainty)
     );
     md.push_str("| part | term | here | paper | se | z |\n|---|---|---|---|---|---|\n");
     for t in &distance.terms {
@@ -99,6 +115,17 @@ pub(super) fn distance_md(md: &mut String, distance: &Distance) {
         let _ = writeln!(md, "\nNot in D (no runs here): {}.", distance.missing.join(", "));
     }
     md.push('\n');
+}
+
+/// How the bracketed intervals of D were made, in one sentence.
+pub(super) fn resampling_note(uncertainty: &GridUncertainty) -> String {
+    format!(
+        "In brackets, the {:.0} % interval from {} resamples of the grid's seeds (every run of a drawn seed, drawn with replacement; \
+         the 2.5 and 97.5 % quantiles; stream seed {:#x}, so the same on every run; docs/statistics.md).",
+        uncertainty.level * 100.0,
+        uncertainty.resamples,
+        uncertainty.seed
+    )
 }
 
 fn banners(md: &mut String, report: &Report) {
@@ -201,7 +228,9 @@ fn grid_section(md: &mut String, report: &Report) {
         md,
         "\nFitness is in % of the theoretical maximum. \"here\" is this grid, \"paper\" is Høverstad (2007). \
          p is Welch's two-tailed two-sample t-test with unequal variances, as in the paper: per task (30 vs 30 runs in the paper) \
-         and for All (the tasks pooled, 90 vs 90). sd is the sample standard deviation; \"–\" marks a value that needs more runs.\n"
+         and for All (the tasks pooled, 90 vs 90). sd is the sample standard deviation; \"–\" marks a value that needs more runs. \
+         In brackets, the {:.0} % interval: Student's t for a mean, the chi-square interval for an sd (docs/statistics.md).\n",
+        LEVEL * 100.0
     );
 }
 
@@ -277,7 +306,12 @@ fn table_md(md: &mut String, table: &Table) {
         if many_metrics {
             cells.push(r.metric.describe().to_string());
         }
-        cells.extend([r.task.clone(), r.n.to_string(), num(r.mean), num(r.sd)]);
+        cells.extend([
+            r.task.clone(),
+            r.n.to_string(),
+            with_interval(r.mean, r.mean_interval),
+            with_interval(r.sd, r.sd_interval),
+        ]);
         if table.p_against.is_some() {
             cells.push(r.p.map_or("–".into(), fmt_p));
         }
@@ -314,7 +348,7 @@ fn bursts_md(md: &mut String, report: &Report) {
             b.config,
             b.runs,
             b.total,
-            num(b.per_run),
+            with_interval(b.per_run, b.per_run_interval),
             num(b.sd),
             if b.per_run.is_nan() {
                 "–".into()
@@ -374,9 +408,12 @@ fn finding_md(md: &mut String, f: &Finding) {
     } else {
         " (the rule does not hold on the paper's own numbers)"
     };
+    let replication = f.replication.map_or(String::new(), |r| {
+        format!(" (the same on {:.0} % of seed resamples)", r * 100.0)
+    });
     let _ = writeln!(
         md,
-        "- **{}** ({}). Paper: {}{check}. Here: {}. — **{}**",
+        "- **{}** ({}). Paper: {}{check}. Here: {}. — **{}**{replication}",
         f.claim,
         f.measure,
         side(&f.paper),
@@ -394,8 +431,11 @@ fn findings_md(md: &mut String, report: &Report) {
          - \"collapse\" = mean under the test < {:.0} % of the same champions' clean mean;\n\
          - \"roughly doubling\" = mean of champions evolved under noise >= {DOUBLING_RATIO} x that of champions evolved clean, both tested under noise, on each of tasks 1 and 2;\n\
          - \"fewer\" = lower mean per run (the paper gives totals over 90 runs);\n\
-         - \"not testable\" = too few counted runs (a Welch rule needs at least 2 per side, a ratio rule 1).\n",
-        COLLAPSE_FRACTION * 100.0
+         - \"not testable\" = too few counted runs (a Welch rule needs at least 2 per side, a ratio rule 1).\n\n\
+         The replication rate after a verdict is the share of {} resamples of the grid's seeds (as for D's interval) on which the rule gives the same verdict: \
+         a verdict near 50 % could go either way on another draw of seeds.\n",
+        COLLAPSE_FRACTION * 100.0,
+        report.uncertainty.resamples
     );
     if !report.reduced.is_empty() || report.runs_counted < report.runs_expected {
         md.push_str("The grid is reduced or partial: the verdicts rest on fewer runs than the paper's.\n\n");
@@ -428,18 +468,39 @@ fn field(x: f64) -> String {
     }
 }
 
-/// The report's tables as CSV, one row per cell; burst mutations follow as
-/// table "bursts" (mean and sd per run; paper_mean is the paper's total / 90).
+/// An interval's two ends as CSV fields: empty without one.
+fn ends(interval: Option<Interval>) -> [String; 2] {
+    interval.map_or([String::new(), String::new()], |i| [field(i.lo), field(i.hi)])
+}
+
+/// A text field, quoted (it may hold commas).
+fn quoted(text: &str) -> String {
+    format!("\"{}\"", text.replace('"', "\"\""))
+}
+
+/// The header of `report.csv`.
+pub const REPORT_CSV_HEADER: &str =
+    "table,configuration,metric,task,n,mean,sd,p,paper_mean,paper_sd,paper_p,mean_lo,mean_hi,sd_lo,sd_hi,verdict,replication";
+
+/// The report as CSV, one row per table cell, with each cell's interval
+/// (`mean_lo`, `mean_hi`, `sd_lo`, `sd_hi`); then burst mutations as table
+/// "bursts" (mean and sd per run; paper_mean is the paper's total / 90);
+/// D and its parts as table "distance" (metric = the part, mean = its value,
+/// mean_lo/mean_hi = its seed-resampling interval); each finding as table
+/// "finding" (configuration = its claim, verdict, replication = the share
+/// of seed resamples with the same verdict).
 pub fn csv(report: &Report) -> String {
-    let mut csv = String::from("table,configuration,metric,task,n,mean,sd,p,paper_mean,paper_sd,paper_p\n");
+    let mut csv = format!("{REPORT_CSV_HEADER}\n");
     for t in &report.tables {
         for r in &t.rows {
             let paper = r
                 .paper
                 .map_or([f64::NAN; 3], |c| [c.mean, c.sd, c.p.unwrap_or(f64::NAN)]);
+            let [mean_lo, mean_hi] = ends(r.mean_interval);
+            let [sd_lo, sd_hi] = ends(r.sd_interval);
             let _ = writeln!(
                 csv,
-                "{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{},{mean_lo},{mean_hi},{sd_lo},{sd_hi},,",
                 t.id,
                 r.config,
                 r.metric.describe(),
@@ -456,14 +517,36 @@ pub fn csv(report: &Report) -> String {
     }
     for b in &report.bursts {
         let paper = b.paper_total.map_or(f64::NAN, |t| t as f64 / PAPER_BURST_RUNS as f64);
+        let [lo, hi] = ends(b.per_run_interval);
         let _ = writeln!(
             csv,
-            "bursts,{},bursts,All,{},{},{},,{},,",
+            "bursts,{},bursts,All,{},{},{},,{},,,{lo},{hi},,,,",
             b.config,
             b.runs,
             field(b.per_run),
             field(b.sd),
             field(paper)
+        );
+    }
+    let d = &report.distance;
+    let i = &report.uncertainty.distance;
+    for (part, value, interval) in [
+        ("D", d.total, i.total),
+        ("means", d.means, i.means),
+        ("spreads", d.spreads, i.spreads),
+        ("burst ratio", d.burst_ratio, i.burst_ratio),
+    ] {
+        let [lo, hi] = ends(interval);
+        let _ = writeln!(csv, "distance,,{part},All,,{},,,,,,{lo},{hi},,,,", field(value));
+    }
+    for f in &report.findings {
+        let _ = writeln!(
+            csv,
+            "finding,{},{},All,,,,,,,,,,,,{},{}",
+            quoted(&f.claim),
+            quoted(&serde_json::to_value(f.rule).map_or(String::new(), |v| v.as_str().unwrap_or_default().to_string())),
+            f.verdict.describe(),
+            f.replication.map_or(String::new(), field)
         );
     }
     csv

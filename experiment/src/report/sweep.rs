@@ -14,8 +14,11 @@ use serde::Serialize;
 use super::distance::Distance;
 use super::findings::Verdict;
 use super::paper::PAPER_TASKS;
-use super::render::num;
+use super::render::{num, with_interval};
 use super::tables::Report;
+use super::uncertainty::{
+    distance_samples, percentile_interval, DistanceIntervals, DistanceSample, Interval, RESAMPLES,
+};
 use super::{GridResults, Metric};
 use crate::grid::grid_file;
 use crate::grid::sweep::{variant_dir, SweepSpec};
@@ -44,6 +47,36 @@ pub struct VariantSummary {
     pub findings: Vec<(String, Verdict)>,
     /// The distance to the paper.
     pub distance: Distance,
+    /// The intervals of D and its parts from resampling the seeds.
+    pub distance_intervals: DistanceIntervals,
+    /// D here minus D of the sweep's reference variant, paired by seed
+    /// (`None` for the reference itself).
+    pub paired: Option<Paired>,
+}
+
+/// A paired difference of D from the reference variant.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Paired {
+    /// D here minus the reference's D;
+    /// NaN when either grid lacks a term of D (no runs for it): their D
+    /// sum different terms.
+    pub difference: f64,
+    /// Its interval over the same seed resamples of both grids (`None` when
+    /// either grid lacks a term of D, on the grid or on a resample).
+    pub interval: Option<Interval>,
+}
+
+impl Paired {
+    /// Whether the interval lies wholly below 0: this variant is closer to
+    /// the paper than the reference beyond seed noise.
+    pub fn closer(&self) -> bool {
+        self.interval.is_some_and(|i| i.hi < 0.0)
+    }
+
+    /// Whether the interval lies wholly above 0: farther beyond seed noise.
+    pub fn farther(&self) -> bool {
+        self.interval.is_some_and(|i| i.lo > 0.0)
+    }
 }
 
 /// A varied setting and the findings whose verdict depends on it.
@@ -66,6 +99,10 @@ pub struct SweepReport {
     pub variants: Vec<VariantSummary>,
     /// Per varied setting.
     pub sensitivity: Vec<Sensitivity>,
+    /// The variant the others are compared with, paired by seed: the first
+    /// (the base in one-at-a-time mode; in combinations, every varied
+    /// setting at its first value).
+    pub reference: String,
     /// Findings reproduced in every variant where they could be judged.
     pub hold_everywhere: Vec<String>,
     /// Findings not reproduced in any variant where they could be judged.
@@ -102,6 +139,8 @@ impl VariantSummary {
             random_init_ratio: ratio(Metric::RandomInit),
             findings: report.findings.iter().map(|f| (f.claim.clone(), f.verdict)).collect(),
             distance: report.distance,
+            distance_intervals: report.uncertainty.distance,
+            paired: None,
         }
     }
 }
@@ -134,6 +173,27 @@ impl SweepReport {
             variants.push(VariantSummary::of(variant.name, variant.settings, &results));
             grids.push(results);
         }
+        // Every variant flies the same seeds: resample i draws the same
+        // seeds in each, so the differences pair by seed.
+        let samples: Vec<Vec<DistanceSample>> = grids.iter().map(|g| distance_samples(g, RESAMPLES)).collect();
+        if let Some((reference, others)) = samples.split_first() {
+            // D sums the terms a grid has runs for: two grids compare only
+            // when neither lacks a term.
+            let reference_complete = variants[0].distance.missing.is_empty();
+            let reference_total = variants[0].distance.total;
+            for (variant, own) in variants.iter_mut().skip(1).zip(others) {
+                let differences: Vec<f64> = own.iter().zip(reference).map(|(a, b)| a.total - b.total).collect();
+                let complete = reference_complete && variant.distance.missing.is_empty();
+                variant.paired = Some(Paired {
+                    difference: if complete {
+                        variant.distance.total - reference_total
+                    } else {
+                        f64::NAN
+                    },
+                    interval: complete.then(|| percentile_interval(&differences)).flatten(),
+                });
+            }
+        }
         let sensitivity = sweep
             .vary
             .iter()
@@ -162,6 +222,7 @@ impl SweepReport {
             order.iter().filter(|c| keep(&judged(c))).cloned().collect()
         };
         let report = SweepReport {
+            reference: variants.first().map_or(String::new(), |v| v.name.clone()),
             hold_everywhere: select(&|v| !v.is_empty() && v.iter().all(|x| *x == Verdict::Reproduced)),
             fail_everywhere: select(&|v| !v.is_empty() && v.iter().all(|x| *x == Verdict::NotReproduced)),
             depend: select(&|v| v.contains(&Verdict::Reproduced) && v.contains(&Verdict::NotReproduced)),
@@ -170,6 +231,63 @@ impl SweepReport {
             sensitivity,
         };
         Ok((report, grids))
+    }
+
+    /// Which variants are closer to the paper than the reference, in
+    /// words: only those whose paired interval of ΔD lies below 0; the
+    /// others cannot be told apart from it on these seeds, or are farther.
+    pub fn verdict(&self) -> String {
+        let closer: Vec<&VariantSummary> = self
+            .variants
+            .iter()
+            .filter(|v| v.paired.is_some_and(|p| p.closer()))
+            .collect();
+        let farther: Vec<&str> = self
+            .variants
+            .iter()
+            .filter(|v| v.paired.is_some_and(|p| p.farther()))
+            .map(|v| v.name.as_str())
+            .collect();
+        let undecided: Vec<&str> = self
+            .variants
+            .iter()
+            .filter(|v| v.paired.is_some_and(|p| !p.closer() && !p.farther()))
+            .map(|v| v.name.as_str())
+            .collect();
+        let list = |names: &[&str]| {
+            if names.is_empty() {
+                "none".to_string()
+            } else {
+                names.join(", ")
+            }
+        };
+        let mut text = match closer
+            .iter()
+            .min_by(|a, b| a.distance.total.total_cmp(&b.distance.total))
+        {
+            Some(best) => format!(
+                "Closest to the paper: {} (D = {:.1}; ΔD from {} {}, an interval below 0).",
+                best.name,
+                best.distance.total,
+                self.reference,
+                best.paired
+                    .map_or(String::new(), |p| with_interval(p.difference, p.interval))
+            ),
+            None => format!(
+                "No variant is closer to the paper than {} beyond seed noise: no paired interval of ΔD lies below 0.",
+                self.reference
+            ),
+        };
+        let names: Vec<&str> = closer.iter().map(|v| v.name.as_str()).collect();
+        let _ = write!(
+            text,
+            " Closer than {} (interval below 0): {}. Farther (above 0): {}. Not told apart from it on these seeds (the interval holds 0): {}.",
+            self.reference,
+            list(&names),
+            list(&farther),
+            list(&undecided)
+        );
+        text
     }
 
     /// The report as Markdown.
@@ -192,18 +310,25 @@ impl SweepReport {
             self.sweep.grid.backend
         );
         md.push_str("## Variants\n\n");
-        md.push_str(
+        let _ = write!(
+            md,
             "Table 1: baseline champions (%), paper 42.4 / 44.0 / 11.9. Bursts per run: baseline and max credit, \
              paper 27.2 and 20.8. Noise and random-init ratios: the baseline champions' robust mean over their clean mean \
              (paper 0.11 and 0.22). D: the distance to the paper (smaller is closer; docs/model.md), then its parts: \
-             the means (Table 1 and 2 means, burst totals), the spreads (their sds) and the burst ratio.\n\n",
+             the means (Table 1 and 2 means, burst totals), the spreads (their sds) and the burst ratio; \
+             in brackets the 95 % interval from resampling the seeds. ΔD: D minus the reference's ({}), \
+             paired by seed (the same seed resamples for both), with its 95 % interval (docs/statistics.md).\n\n",
+            self.reference
         );
-        md.push_str("| variant | runs | T1 task 1 | T1 task 2 | T1 task 3 | bursts base | bursts max | noise ratio | random-init ratio | D | means | spreads | burst ratio |\n");
-        md.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        md.push_str("| variant | runs | T1 task 1 | T1 task 2 | T1 task 3 | bursts base | bursts max | noise ratio | random-init ratio | D | ΔD | means | spreads | burst ratio |\n");
+        md.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
         for v in &self.variants {
+            let paired = v
+                .paired
+                .map_or("reference".to_string(), |p| with_interval(p.difference, p.interval));
             let _ = writeln!(
                 md,
-                "| {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.1} |",
+                "| {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {} | {paired} | {} | {} | {} |",
                 v.name,
                 v.runs.0,
                 v.runs.1,
@@ -214,23 +339,13 @@ impl SweepReport {
                 num(v.bursts_per_run[1]),
                 ratio(v.noise_ratio),
                 ratio(v.random_init_ratio),
-                v.distance.total,
-                v.distance.means,
-                v.distance.spreads,
-                v.distance.burst_ratio
+                with_interval(v.distance.total, v.distance_intervals.total),
+                with_interval(v.distance.means, v.distance_intervals.means),
+                with_interval(v.distance.spreads, v.distance_intervals.spreads),
+                with_interval(v.distance.burst_ratio, v.distance_intervals.burst_ratio)
             );
         }
-        if let Some(best) = self
-            .variants
-            .iter()
-            .min_by(|a, b| a.distance.total.total_cmp(&b.distance.total))
-        {
-            let _ = writeln!(
-                md,
-                "\nClosest to the paper: {} (D = {:.1}).",
-                best.name, best.distance.total
-            );
-        }
+        let _ = writeln!(md, "\n{}", self.verdict());
         md.push_str("\n## Findings per variant\n\n");
         let claims: Vec<&String> = self
             .variants
@@ -369,7 +484,77 @@ mod tests {
                 terms: Vec::new(),
                 missing: Vec::new(),
             },
+            distance_intervals: DistanceIntervals {
+                total: None,
+                means: None,
+                spreads: None,
+                burst_ratio: None,
+            },
+            paired: None,
         }
+    }
+
+    fn sweep_of(variants: Vec<VariantSummary>) -> SweepReport {
+        SweepReport {
+            sweep: SweepSpec::new(
+                crate::grid::GridSpec::from_preset(crate::grid::GridPreset::Quick),
+                vec![crate::grid::sweep::parse_vary("esp.stagnation=20,30,40,50").unwrap()],
+                crate::grid::sweep::SweepMode::Combinations,
+            )
+            .unwrap(),
+            reference: variants[0].name.clone(),
+            variants,
+            sensitivity: Vec::new(),
+            hold_everywhere: Vec::new(),
+            fail_everywhere: Vec::new(),
+            depend: Vec::new(),
+        }
+    }
+
+    fn paired(name: &str, total: f64, lo: f64, hi: f64) -> VariantSummary {
+        let mut v = variant(&[], &[]);
+        v.name = name.into();
+        v.distance.total = total;
+        v.paired = Some(Paired {
+            difference: total - 100.0,
+            interval: Some(Interval { lo, hi }),
+        });
+        v
+    }
+
+    #[test]
+    fn a_variant_is_named_closer_only_when_its_paired_interval_lies_below_zero() {
+        let mut reference = variant(&[], &[]);
+        reference.name = "v0".into();
+        reference.distance.total = 100.0;
+        // The lowest D, but its interval holds 0: not told apart.
+        let report = sweep_of(vec![
+            reference.clone(),
+            paired("v1", 60.0, -90.0, 5.0),
+            paired("v2", 130.0, 10.0, 50.0),
+        ]);
+        let text = report.verdict();
+        assert!(
+            text.starts_with("No variant is closer to the paper than v0 beyond seed noise"),
+            "{text}"
+        );
+        assert!(
+            text.contains("Farther (above 0): v2.") && text.contains("the interval holds 0): v1."),
+            "{text}"
+        );
+        assert!(report.markdown().contains(&text));
+        // One interval below 0: that variant is named, even where another has a lower D.
+        let report = sweep_of(vec![
+            reference,
+            paired("v1", 60.0, -90.0, 5.0),
+            paired("v2", 80.0, -30.0, -2.0),
+        ]);
+        let text = report.verdict();
+        assert!(
+            text.starts_with("Closest to the paper: v2 (D = 80.0; ΔD from v0 -20.0 [-30.0, -2.0]"),
+            "{text}"
+        );
+        assert!(text.contains("Closer than v0 (interval below 0): v2."), "{text}");
     }
 
     #[test]

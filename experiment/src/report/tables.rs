@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use super::findings::{findings, Finding};
 use super::paper::{paper_bursts, paper_cell, PaperCell};
+use super::uncertainty::{grid_uncertainty, mean_interval, sd_interval, GridUncertainty, Interval, RESAMPLES};
 use super::{GridResults, Metric, Problem};
 use crate::grid::{GridPreset, GridSpec, RunStatus};
 use crate::results::stats::{mean_sd, welch};
@@ -32,6 +33,10 @@ pub struct Row {
     pub mean: f64,
     /// Sample sd here (NaN when n < 2).
     pub sd: f64,
+    /// The 95 % t interval of the mean here (`None` when n < 2).
+    pub mean_interval: Option<Interval>,
+    /// The 95 % chi-square interval of the sd here (`None` when n < 2).
+    pub sd_interval: Option<Interval>,
     /// Welch p here against the table's reference (NaN when n < 2 on either side).
     pub p: Option<f64>,
     /// The paper's cell, if it has one.
@@ -64,6 +69,8 @@ pub struct BurstRow {
     pub per_run: f64,
     /// Sample sd per run.
     pub sd: f64,
+    /// The 95 % t interval of the mean per run (`None` with fewer than 2 runs).
+    pub per_run_interval: Option<Interval>,
     /// The paper's total over its 90 runs, if given.
     pub paper_total: Option<usize>,
 }
@@ -135,6 +142,9 @@ pub struct Report {
     pub findings: Vec<Finding>,
     /// The distance to the paper (`docs/model.md`).
     pub distance: Distance,
+    /// D's intervals and the findings' replication rates, from resampling
+    /// the grid's seeds ([`super::uncertainty`]).
+    pub uncertainty: GridUncertainty,
     /// The figures written.
     pub figures: Vec<FigureLink>,
     /// Figures that could not be drawn.
@@ -213,6 +223,7 @@ impl Report {
             .map(|(id, title, configs)| champion_table(results, id, title, configs))
             .collect();
         tables.extend(robustness_tables(results));
+        let mut judged = findings(results);
         Report {
             grid: spec.clone(),
             reduced: reductions(spec),
@@ -225,7 +236,8 @@ impl Report {
             problems: results.problems.clone(),
             tables,
             bursts: burst_rows(results),
-            findings: findings(results),
+            uncertainty: grid_uncertainty(results, &mut judged, RESAMPLES),
+            findings: judged,
             distance: Distance::of(results),
             figures: Vec::new(),
             figure_problems: Vec::new(),
@@ -268,6 +280,8 @@ fn row(
         n: values.len(),
         mean,
         sd,
+        mean_interval: mean_interval(&values),
+        sd_interval: sd_interval(&values),
         p,
         paper: paper_cell(config, metric, *paper_task),
     }
@@ -344,6 +358,7 @@ fn burst_rows(results: &GridResults) -> Vec<BurstRow> {
                 total: values.iter().sum::<f64>() as usize,
                 per_run,
                 sd,
+                per_run_interval: mean_interval(&values),
                 paper_total: paper_bursts(config),
             }
         })

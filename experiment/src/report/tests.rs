@@ -227,8 +227,8 @@ fn writes_markdown_figures_csv_and_json() {
         "2000 generations",
         "configurations left out: systematic",
         "tasks left out: 3",
-        "| 1 | 3 | 20.0 | 10.0 | 42.4 | 12.8 |",
-        "| 1 | 3 | 50.0 | 10.0 | 2.1e-2 | 56.7 | 14.8 | 1.8e-4 |",
+        "| 1 | 3 | 20.0 [-4.8, 44.8] | 10.0 [5.2, 62.8] | 42.4 | 12.8 |",
+        "| 1 | 3 | 50.0 [25.2, 74.8] | 10.0 [5.2, 62.8] | 2.1e-2 | 56.7 | 14.8 | 1.8e-4 |",
         "git commit abc123",
         "**max credit is clearly better than the baseline**",
         "— **reproduced**",
@@ -257,8 +257,11 @@ fn writes_markdown_figures_csv_and_json() {
     let outcome = write_report(dir.path(), ReportFormat::Csv).unwrap();
     assert_eq!(outcome.written[2], dir.path().join("report.csv"));
     let csv = std::fs::read_to_string(dir.path().join("report.csv")).unwrap();
-    assert!(csv.starts_with("table,configuration,metric,task,n,mean,sd,p,paper_mean,paper_sd,paper_p\n"));
-    assert!(csv.contains("\n1,baseline,champion,1,3,20,10,,42.4,12.8,\n"), "{csv}");
+    assert!(csv.starts_with(&format!("{}\n", super::render::REPORT_CSV_HEADER)));
+    assert!(
+        csv.contains("\n1,baseline,champion,1,3,20,10,,42.4,12.8,,-4.8"),
+        "{csv}"
+    );
     assert!(csv.contains("\nbursts,baseline,bursts,All,6,2,"), "{csv}");
 }
 
@@ -454,4 +457,114 @@ fn the_burst_ratio_is_max_credit_over_baseline_in_the_se_of_two_counts() {
     assert_eq!((ratio.here, ratio.paper), (0.0, paper));
     assert!(close(ratio.se, paper * (1.0 / 2448.0 + 1.0 / 1868.0f64).sqrt()));
     assert!(close(d.burst_ratio, ratio.z * ratio.z));
+}
+
+/// The grid made of the runs of `seeds` (with repeats), as a resample is.
+fn with_seeds(results: &GridResults, seeds: &[u64]) -> GridResults {
+    GridResults {
+        runs: seeds
+            .iter()
+            .flat_map(|&s| results.runs.iter().filter(move |r| r.key.seed == s).cloned())
+            .collect(),
+        ..results.clone()
+    }
+}
+
+/// Whether `x` lies between the order statistics around quantile `q` of `sorted`.
+fn near_quantile(x: f64, sorted: &[f64], q: f64) -> bool {
+    let at = q * (sorted.len() - 1) as f64;
+    let (below, above) = (
+        sorted[(at.floor() as usize).saturating_sub(1)],
+        sorted[(at.ceil() as usize + 1).min(sorted.len() - 1)],
+    );
+    below - 1e-9 <= x && x <= above + 1e-9
+}
+
+#[test]
+fn intervals_and_replication_rates_match_a_direct_computation() {
+    use super::uncertainty::{seed_draws, LEVEL, RESAMPLES};
+    // All three tasks, so that every term of D has runs.
+    let dir = tempfile::tempdir().unwrap();
+    let spec = GridSpec {
+        tasks: Task::VARIANTS.to_vec(),
+        ..spec()
+    };
+    spec.save(dir.path()).unwrap();
+    for key in spec.runs() {
+        write_run(dir.path(), &spec, &key);
+    }
+    let results = GridResults::load(dir.path()).unwrap();
+    let report = Report::from_results(&results);
+    assert!(report.distance.missing.is_empty());
+
+    // A cell: baseline champions on task 1 are 10, 20, 30 (mean 20, sd 10,
+    // n 3). Student's t(0.975, 2) = 4.302652729911275; the chi-square with
+    // 2 degrees of freedom has quantiles -2 ln(1 - q).
+    let row = cell(table(&report, "1"), BASELINE, Metric::Champion, "1");
+    let mean = row.mean_interval.unwrap();
+    let half = 4.302652729911275 * 10.0 / 3f64.sqrt();
+    assert!(close(mean.lo, 20.0 - half) && close(mean.hi, 20.0 + half), "{mean:?}");
+    let sd = row.sd_interval.unwrap();
+    let tail = (1.0 - LEVEL) / 2.0;
+    let chi = |q: f64| -2.0 * (1.0 - q).ln();
+    assert!(close(sd.lo, (200.0 / chi(1.0 - tail)).sqrt()), "{sd:?}");
+    assert!(close(sd.hi, (200.0 / chi(tail)).sqrt()), "{sd:?}");
+
+    // D and the verdicts on every resample, computed here from the draws.
+    let resampled: Vec<GridResults> = (0..RESAMPLES)
+        .map(|i| with_seeds(&results, &seed_draws(1, 3, i)))
+        .collect();
+    let mut totals: Vec<f64> = resampled.iter().map(|g| Distance::of(g).total).collect();
+    totals.sort_by(f64::total_cmp);
+    let d = report.uncertainty.distance.total.unwrap();
+    assert!(
+        near_quantile(d.lo, &totals, tail) && near_quantile(d.hi, &totals, 1.0 - tail),
+        "{d:?}"
+    );
+    assert!(d.lo < d.hi, "three seeds that differ give a spread");
+    let verdicts: Vec<Vec<Verdict>> = resampled
+        .iter()
+        .map(|g| super::findings::findings(g).iter().map(|f| f.verdict).collect())
+        .collect();
+    for (i, f) in report.findings.iter().enumerate() {
+        let same = verdicts.iter().filter(|v| v[i] == f.verdict).count();
+        let expected = (f.verdict != Verdict::NotTestable).then_some(same as f64 / RESAMPLES as f64);
+        assert_eq!(f.replication, expected, "{}", f.claim);
+    }
+    // Max credit's bursts (0) are below the baseline's (the seed) on every resample.
+    assert_eq!(finding(&report, "fewer burst").replication, Some(1.0));
+
+    // The same in the files: report.md, report.csv and report.json.
+    write_report(dir.path(), ReportFormat::Csv).unwrap();
+    let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+    assert!(
+        md.contains(&format!(
+            "| 1 | 3 | 20.0 [{:.1}, {:.1}] | 10.0 [",
+            20.0 - half,
+            20.0 + half
+        )),
+        "{md}"
+    );
+    assert!(
+        md.contains(&format!("D = {:.1} [{:.1}, {:.1}]", report.distance.total, d.lo, d.hi)),
+        "{md}"
+    );
+    assert!(md.contains("(the same on 100 % of seed resamples)"), "{md}");
+    let csv = std::fs::read_to_string(dir.path().join("report.csv")).unwrap();
+    assert!(
+        csv.contains(&format!(
+            "distance,,D,All,,{},,,,,,{},{},,,,",
+            report.distance.total, d.lo, d.hi
+        )),
+        "{csv}"
+    );
+    assert!(csv.contains("finding,\"max credit needs fewer burst mutations than the baseline\",\"fewer\",All,,,,,,,,,,,,reproduced,1\n"), "{csv}");
+    write_report(dir.path(), ReportFormat::Json).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("report.json")).unwrap()).unwrap();
+    assert_eq!(json["uncertainty"]["distance"]["total"]["lo"], d.lo);
+    assert_eq!(json["uncertainty"]["resamples"], RESAMPLES);
+    assert_eq!(json["tables"][0]["rows"][0]["mean_interval"]["hi"], mean.hi);
+    // The same numbers on every run.
+    assert_eq!(Report::from_results(&results).uncertainty, report.uncertainty);
 }
