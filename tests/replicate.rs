@@ -554,3 +554,77 @@ fn a_first_seed_grid_runs_the_seeds_of_a_larger_grid_byte_for_byte_and_extends_a
     );
     assert!(!tmp.path().join("far").exists());
 }
+
+#[test]
+fn a_sweep_runs_a_run_its_variants_share_once_and_writes_the_files_a_run_of_each_variant_writes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (sweep, alone) = (tmp.path().join("sweep"), tmp.path().join("alone"));
+    let config = tmp.path().join("start.toml");
+    std::fs::write(&config, "[problem.tasks]\ntask2_spin = 0.5\n").unwrap();
+    // Task 2's start changes task 2's runs only: task 1's are the base's.
+    let o = psa_esp(&[
+        "sweep",
+        "--vary",
+        "problem.tasks.task2_spin=-0.75,0.5",
+        "--configs",
+        "baseline",
+        "--tasks",
+        "1,2",
+        "--seeds",
+        "2",
+        "--generations",
+        "3",
+        "--robustness-trials",
+        "5",
+        "--out",
+        sweep.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("(2 of them shared with an earlier variant, run once: 2 written from it now)"),
+        "{out}"
+    );
+    // The second variant's files are those of a grid run under its setting, byte for byte.
+    let mut args = tiny_baseline_grid("1,2", "2", &alone).to_vec();
+    args.extend(["--config", config.to_str().unwrap()]);
+    assert!(psa_esp(&args).status.success());
+    let variant = std::fs::read_dir(sweep.join("variants"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.to_string_lossy().contains("v1-"))
+        .unwrap();
+    let shared = results(&variant);
+    assert_eq!(shared.len(), 4 * 4);
+    assert!(
+        shared == results(&alone),
+        "the shared runs differ from runs of their own"
+    );
+    let champion = std::fs::read_to_string(variant.join("runs/baseline/task1/seed1/champion.json")).unwrap();
+    assert!(champion.contains("\"task2_spin\": 0.5"));
+    // Resumed, nothing runs again; a shared run removed is written again from its source.
+    std::fs::remove_dir_all(variant.join("runs/baseline/task1/seed2")).unwrap();
+    let o = psa_esp(&[
+        "sweep",
+        "--vary",
+        "problem.tasks.task2_spin=-0.75,0.5",
+        "--configs",
+        "baseline",
+        "--tasks",
+        "1,2",
+        "--seeds",
+        "2",
+        "--generations",
+        "3",
+        "--robustness-trials",
+        "5",
+        "--out",
+        sweep.to_str().unwrap(),
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("1 written from it now") && out.contains("0 run now"),
+        "{out}"
+    );
+    assert!(results(&variant) == shared);
+}

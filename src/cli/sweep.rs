@@ -41,10 +41,12 @@ pub fn run(args: SweepArgs) -> Result<i32> {
     let summary = summary?;
     report_held(summary.held.iter().map(|(variant, h)| (format!("{variant}: "), h)));
     say!(
-        "sweep {}: {} variants, {} runs, {} already finished, {} run now, {} left to other processes, in {:.0} s",
+        "sweep {}: {} variants, {} runs ({} of them shared with an earlier variant, run once: {} written from it now), {} already finished, {} run now, {} left to other processes, in {:.0} s",
         args.out.display(),
         summary.variants,
         summary.total,
+        summary.shared,
+        summary.written_from_shared,
         summary.skipped,
         summary.ran,
         summary.held.len(),

@@ -24,6 +24,7 @@ pub mod replicate;
 pub mod rescore;
 pub mod runner;
 pub mod shard;
+pub mod shared;
 pub mod sweep;
 
 use std::path::{Path, PathBuf};

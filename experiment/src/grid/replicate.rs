@@ -250,6 +250,7 @@ pub fn replicate(
         dir,
         spec,
         shard: options.shard,
+        elsewhere: &[],
     };
     let mut summaries = replicate_grids(&[job], options, progress)?;
     Ok(summaries.remove(0))
@@ -265,6 +266,9 @@ pub struct GridJob<'a> {
     pub spec: &'a GridSpec,
     /// The runs of it this process does.
     pub shard: Shard,
+    /// Runs of it that another grid flies (a sweep's shared runs,
+    /// [`crate::grid::shared`]): never run here, written from that grid's.
+    pub elsewhere: &'a [RunKey],
 }
 
 /// Runs several grids (a sweep's variants) as one, as [`replicate`] runs
@@ -285,6 +289,7 @@ pub fn replicate_grids(
     let mut skipped = Vec::new();
     for (grid, job) in grids.iter().enumerate() {
         let (runs, finished) = prepare(job.dir, job.spec, job.shard, Judge::Resume)?;
+        let runs: Vec<RunKey> = runs.into_iter().filter(|k| !job.elsewhere.contains(k)).collect();
         totals.push(runs.len() + finished);
         skipped.push(finished);
         todo.extend(runs.into_iter().map(|key| (grid, key)));

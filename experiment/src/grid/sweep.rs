@@ -18,7 +18,9 @@ use psa_sim::named::Named;
 use serde::{Deserialize, Serialize};
 
 use crate::grid::replicate::{replicate_grids, GridJob, GridProgress, HeldRun, ReplicateOptions};
-use crate::grid::GridSpec;
+use crate::grid::shard::Shard;
+use crate::grid::shared::{shared_runs, write_shared};
+use crate::grid::{GridSpec, Judge, RunKey};
 use crate::RunConfig;
 
 /// The `format` of `sweep.json`.
@@ -490,6 +492,10 @@ fn set_dotted(table: &mut toml::Table, key: &str, value: &str) -> Result<()> {
 pub struct SweepSummary {
     /// Variants.
     pub variants: usize,
+    /// Runs a variant shares with an earlier variant (run once, there).
+    pub shared: usize,
+    /// Shared runs written now from their earlier variant's.
+    pub written_from_shared: usize,
     /// Runs over all variants.
     pub total: usize,
     /// Runs already finished.
@@ -522,23 +528,39 @@ pub fn sweep(
             .with_context(|| format!("variant {}", variant.name))?;
         grids.push((variant_dir(dir, variant), grid));
     }
+    // Runs a variant shares with an earlier one run once, there; the
+    // others are written from them (those finished before this process too).
+    let shared = shared_runs(&grids)?;
+    let elsewhere: Vec<Vec<RunKey>> = (0..grids.len())
+        .map(|g| shared.iter().filter(|s| s.grid == g).map(|s| s.key).collect())
+        .collect();
     let mut before = 0;
     let jobs: Vec<GridJob> = grids
         .iter()
-        .map(|(folder, grid)| {
+        .zip(&elsewhere)
+        .map(|((folder, grid), elsewhere)| {
             let shard = options.shard.after(before);
             before += grid.runs().len();
             GridJob {
                 dir: folder,
                 spec: grid,
                 shard,
+                elsewhere,
             }
         })
         .collect();
+    // Each variant's folder and grid.json exist before a shared run is written into it.
+    for job in &jobs {
+        crate::grid::replicate::prepare(job.dir, job.spec, Shard::ALL, Judge::Resume)?;
+    }
+    let mut written = write_shared(&grids, &shared)?;
     let summaries = replicate_grids(&jobs, options, progress)?;
+    written += write_shared(&grids, &shared)?;
     let seconds = summaries.first().map_or(0.0, |s| s.seconds);
     let mut summary = SweepSummary {
         variants: variants.len(),
+        shared: shared.len(),
+        written_from_shared: written,
         total: 0,
         skipped: 0,
         ran: 0,
