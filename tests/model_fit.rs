@@ -361,3 +361,63 @@ fn a_sweep_runs_a_grid_per_variant_and_reports_the_distance_and_sensitivity() {
         assert_eq!(part_sum("burst_ratio"), d["burst_ratio"].as_f64().unwrap());
     }
 }
+
+#[test]
+fn the_text_model_sets_exactly_the_settings_the_papers_words_decide_each_with_its_words() {
+    let path = repo("configs/text.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let defaults = psa_experiment::RunConfig::baseline_with("").unwrap();
+    let model = psa_experiment::RunConfig::baseline_with(&text).unwrap();
+    let mut changed: Vec<String> = psa_experiment::grid::differences(&defaults, &model)
+        .unwrap()
+        .into_iter()
+        .map(|(key, _, _)| key)
+        .collect();
+    changed.sort();
+    assert_eq!(
+        changed,
+        [
+            "problem.fitness.scoring",
+            "problem.fitness.slowing",
+            "problem.fitness.state",
+            "problem.noise.on_bias",
+            "problem.sensors.angular_velocity_scale",
+            "problem.sensors.heading_input",
+            "problem.sensors.heading_scale",
+            "problem.sensors.position_scale",
+            "problem.sensors.velocity_scale",
+            "problem.tasks.task2_spin",
+        ]
+    );
+    // Every setting follows a comment that quotes the paper and names its section.
+    let mut comment = String::new();
+    for line in text.lines() {
+        if let Some(c) = line.strip_prefix('#') {
+            comment.push_str(c);
+        } else if line.contains(" = ") {
+            assert!(
+                comment.contains('"') && comment.contains('§'),
+                "{line}: no quoted words before it"
+            );
+            comment.clear();
+        } else if line.trim().is_empty() || line.starts_with('[') {
+            comment.clear();
+        }
+    }
+    // It flies every task.
+    let tmp = tempfile::tempdir().unwrap();
+    for task in ["1", "2", "3"] {
+        let out = tmp.path().join(task);
+        ok(&psa_esp(&[
+            "evolve",
+            "--task",
+            task,
+            "--generations",
+            "2",
+            "--config",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]));
+    }
+}

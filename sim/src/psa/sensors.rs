@@ -16,10 +16,11 @@ pub const INPUT_COUNT: usize = 7;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum HeadingInput {
-    /// The heading minus the target heading. `[chosen]` default
+    /// The heading minus the target heading. `[fitted]` default (D, S13 and S19)
     #[default]
     Error,
-    /// The heading itself (the paper says only x and y are relative to the target).
+    /// The heading itself: the paper's input is "heading" (§2), and x and y
+    /// are relative to the target only in its fitness (§2.2).
     Absolute,
 }
 
@@ -64,8 +65,10 @@ pub enum NoiseStage {
 /// Input scaling: one factor, `[fitted]` 0.5, on the scales 10 per m, 10
 /// per m/s, 1 per rad and 1 per rad/s (docs/sweeps/s04-sensor-scaling.md,
 /// s39-sensor-scales.md, s41-s44-one-factor-and-task2-start.md); the
-/// inputs then lie about 0.75 to 3 (the box's 0.2 m, 0.4 m/s, a heading
-/// error of up to 2 pi, 1.5 rad/s), 15 to 60 times the noise (sd 0.05).
+/// inputs then lie about 0.75 to 3.1 (the box's 0.2 m, 0.4 m/s, a heading
+/// error of up to 2 pi, 1.5 rad/s), 15 to 63 times the noise (sd 0.05).
+/// The text's "about two orders of magnitude" (§5.1) reads as factor 1
+/// (30 to 126 times): the fit moved away from it (configs/text.toml).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSettings {
@@ -79,7 +82,7 @@ pub struct SensorSettings {
     pub angular_velocity_scale: f64,
     /// The constant bias input. `[chosen]` 1
     pub bias: f64,
-    /// What the heading input measures. `[chosen]` error
+    /// What the heading input measures. `[fitted]` error (D, S13 and S19)
     pub heading_input: HeadingInput,
     /// The range the heading input is wrapped to. `[fitted]` positive,
     /// [0, 2 pi) (docs/sweeps/s16-s21-s23-heading-range.md, S21 and S22)
@@ -199,7 +202,8 @@ impl SensorSettings {
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseSettings {
-    /// Standard deviation of the noise on every input but the bias. `[paper]` 0 (0.05 in robustness tests)
+    /// Standard deviation of the noise on every input (the bias too with
+    /// `on_bias`, a `[chosen]` reading). `[paper]` 0 (0.05 in robustness tests)
     pub input_sd: f64,
     /// Standard deviation of the noise on every output, before clamping to [0, 1]. `[paper]` 0
     pub output_sd: f64,

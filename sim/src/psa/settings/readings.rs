@@ -168,7 +168,7 @@ pub const READINGS: &[Reading] = &[
     Reading {
         key: "sensors.heading_input",
         doc: "the heading input: `error` (the heading minus the target's) or `absolute` (the heading itself)",
-        tag: Tag::Chosen,
+        tag: Tag::Fitted,
         define: Some(Define {
             name: "PSA_HEADING_ABSOLUTE",
             on: |s| s.sensors.heading_input == HeadingInput::Absolute,
