@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 
 use super::choice::choice;
-use psa_experiment::report::{write_report, ReportFormat};
+use psa_experiment::report::{write_report_against, ReportFormat};
 
 /// Arguments of `report`.
 #[derive(Debug, clap::Args)]
@@ -18,6 +18,10 @@ pub struct ReportArgs {
     /// go to DIR/figures/ in every case.
     #[arg(long, value_parser = choice::<ReportFormat>(), default_value_t = ReportFormat::Md)]
     pub format: ReportFormat,
+    /// Another grid on the same seeds (a rescored copy, another --config):
+    /// D here minus D there, paired by seed, with its 95 % interval.
+    #[arg(long, value_name = "GRID")]
+    pub against: Option<PathBuf>,
 }
 
 /// Runs `report`: exit code 0, or 1 when a run folder is damaged or holds
@@ -25,6 +29,12 @@ pub struct ReportArgs {
 /// A directory that is not a grid is an error (exit code 2).
 pub fn run(args: ReportArgs) -> Result<i32> {
     if psa_experiment::grid::sweep::sweep_file(&args.dir).exists() {
+        if args.against.is_some() {
+            anyhow::bail!(
+                "--against compares two grids; {} is a sweep, whose report compares its variants paired by seed itself",
+                args.dir.display()
+            );
+        }
         let (_, markdown, written) = psa_experiment::report::write_sweep_report(&args.dir)?;
         say!("{}", markdown.trim_end());
         for path in written {
@@ -32,7 +42,7 @@ pub fn run(args: ReportArgs) -> Result<i32> {
         }
         return Ok(0);
     }
-    let outcome = write_report(&args.dir, args.format)?;
+    let outcome = write_report_against(&args.dir, args.format, args.against.as_deref())?;
     if args.format == ReportFormat::Md {
         say!("{}", outcome.markdown.trim_end());
     }

@@ -72,6 +72,17 @@ pub fn markdown(report: &Report) -> String {
         table_md(&mut md, table);
     }
     distance_md(&mut md, &report.distance, &report.uncertainty);
+    if let Some(against) = &report.against {
+        let p = &against.paired;
+        let _ = writeln!(
+            md,
+            "Against `{}` (D = {:.1}), paired by seed: ΔD = {}; this grid is {}.\n",
+            against.reference,
+            against.reference_total,
+            with_interval(p.difference, p.interval),
+            p.describe("it")
+        );
+    }
     findings_md(&mut md, report);
     figures_md(&mut md, report);
     md
@@ -538,6 +549,15 @@ pub fn csv(report: &Report) -> String {
     ] {
         let [lo, hi] = ends(interval);
         let _ = writeln!(csv, "distance,,{part},All,,{},,,,,,{lo},{hi},,,,", field(value));
+    }
+    if let Some(against) = &report.against {
+        let [lo, hi] = ends(against.paired.interval);
+        let _ = writeln!(
+            csv,
+            "distance,{},difference,All,,{},,,,,,{lo},{hi},,,,",
+            quoted(&against.reference),
+            field(against.paired.difference)
+        );
     }
     for f in &report.findings {
         let _ = writeln!(

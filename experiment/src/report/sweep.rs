@@ -16,9 +16,7 @@ use super::findings::Verdict;
 use super::paper::PAPER_TASKS;
 use super::render::{num, with_interval};
 use super::tables::Report;
-use super::uncertainty::{
-    distance_samples, percentile_interval, DistanceIntervals, DistanceSample, Interval, RESAMPLES,
-};
+use super::uncertainty::{distance_samples, DistanceIntervals, DistanceSample, Paired, RESAMPLES};
 use super::{GridResults, Metric};
 use crate::grid::grid_file;
 use crate::grid::sweep::{variant_dir, SweepSpec};
@@ -52,31 +50,6 @@ pub struct VariantSummary {
     /// D here minus D of the sweep's reference variant, paired by seed
     /// (`None` for the reference itself).
     pub paired: Option<Paired>,
-}
-
-/// A paired difference of D from the reference variant.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Paired {
-    /// D here minus the reference's D;
-    /// NaN when either grid lacks a term of D (no runs for it): their D
-    /// sum different terms.
-    pub difference: f64,
-    /// Its interval over the same seed resamples of both grids (`None` when
-    /// either grid lacks a term of D, on the grid or on a resample).
-    pub interval: Option<Interval>,
-}
-
-impl Paired {
-    /// Whether the interval lies wholly below 0: this variant is closer to
-    /// the paper than the reference beyond seed noise.
-    pub fn closer(&self) -> bool {
-        self.interval.is_some_and(|i| i.hi < 0.0)
-    }
-
-    /// Whether the interval lies wholly above 0: farther beyond seed noise.
-    pub fn farther(&self) -> bool {
-        self.interval.is_some_and(|i| i.lo > 0.0)
-    }
 }
 
 /// A varied setting and the findings whose verdict depends on it.
@@ -177,21 +150,8 @@ impl SweepReport {
         // seeds in each, so the differences pair by seed.
         let samples: Vec<Vec<DistanceSample>> = grids.iter().map(|g| distance_samples(g, RESAMPLES)).collect();
         if let Some((reference, others)) = samples.split_first() {
-            // D sums the terms a grid has runs for: two grids compare only
-            // when neither lacks a term.
-            let reference_complete = variants[0].distance.missing.is_empty();
-            let reference_total = variants[0].distance.total;
-            for (variant, own) in variants.iter_mut().skip(1).zip(others) {
-                let differences: Vec<f64> = own.iter().zip(reference).map(|(a, b)| a.total - b.total).collect();
-                let complete = reference_complete && variant.distance.missing.is_empty();
-                variant.paired = Some(Paired {
-                    difference: if complete {
-                        variant.distance.total - reference_total
-                    } else {
-                        f64::NAN
-                    },
-                    interval: complete.then(|| percentile_interval(&differences)).flatten(),
-                });
+            for ((variant, own), grid) in variants.iter_mut().skip(1).zip(others).zip(&grids[1..]) {
+                variant.paired = Some(Paired::of(grid, own, &grids[0], reference));
             }
         }
         let sensitivity = sweep
@@ -510,6 +470,8 @@ mod tests {
             depend: Vec::new(),
         }
     }
+
+    use crate::report::uncertainty::Interval;
 
     fn paired(name: &str, total: f64, lo: f64, hi: f64) -> VariantSummary {
         let mut v = variant(&[], &[]);

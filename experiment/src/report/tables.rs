@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::findings::{findings, Finding};
 use super::paper::{paper_bursts, paper_cell, PaperCell};
-use super::uncertainty::{grid_uncertainty, mean_interval, sd_interval, GridUncertainty, Interval, RESAMPLES};
+use super::uncertainty::{grid_uncertainty, mean_interval, sd_interval, Against, GridUncertainty, Interval, RESAMPLES};
 use super::{GridResults, Metric, Problem};
 use crate::grid::{GridPreset, GridSpec, RunStatus};
 use crate::results::stats::{mean_sd, welch};
@@ -145,6 +145,10 @@ pub struct Report {
     /// D's intervals and the findings' replication rates, from resampling
     /// the grid's seeds ([`super::uncertainty`]).
     pub uncertainty: GridUncertainty,
+    /// D against another grid's on the same seeds, paired by seed (`report
+    /// --against`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub against: Option<Against>,
     /// The figures written.
     pub figures: Vec<FigureLink>,
     /// Figures that could not be drawn.
@@ -238,6 +242,7 @@ impl Report {
             bursts: burst_rows(results),
             uncertainty: grid_uncertainty(results, &mut judged, RESAMPLES),
             findings: judged,
+            against: None,
             distance: Distance::of(results),
             figures: Vec::new(),
             figure_problems: Vec::new(),

@@ -568,3 +568,41 @@ fn intervals_and_replication_rates_match_a_direct_computation() {
     // The same numbers on every run.
     assert_eq!(Report::from_results(&results).uncertainty, report.uncertainty);
 }
+
+#[test]
+fn a_grid_against_another_on_the_same_seeds_is_compared_paired_and_on_other_seeds_refused() {
+    // All three tasks: every term of D has runs.
+    let spec = GridSpec {
+        tasks: Task::VARIANTS.to_vec(),
+        ..spec()
+    };
+    let written = || {
+        let dir = tempfile::tempdir().unwrap();
+        spec.save(dir.path()).unwrap();
+        for key in spec.runs() {
+            write_run(dir.path(), &spec, &key);
+        }
+        dir
+    };
+    let (dir, same) = (written(), written());
+    let outcome = write_report_against(dir.path(), ReportFormat::Csv, Some(same.path())).unwrap();
+    // The same runs: ΔD is 0 on every resample, so not told apart.
+    assert!(
+        outcome
+            .markdown
+            .contains("paired by seed: ΔD = 0.0 [0.0, 0.0]; this grid is not told apart on these seeds from it."),
+        "{}",
+        outcome.markdown
+    );
+    let csv = std::fs::read_to_string(dir.path().join("report.csv")).unwrap();
+    assert!(csv.contains(",difference,All,,0,,,,,,0,0,,,,\n"), "{csv}");
+    let shifted = tempfile::tempdir().unwrap();
+    let other = GridSpec {
+        first_seed: 2,
+        ..spec.clone()
+    };
+    other.save(shifted.path()).unwrap();
+    let err = write_report_against(dir.path(), ReportFormat::Md, Some(shifted.path())).unwrap_err();
+    let text = format!("{err:#}");
+    assert!(text.contains("seeds 1 to 3") && text.contains("seeds 2 to 4"), "{text}");
+}

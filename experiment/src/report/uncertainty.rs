@@ -287,3 +287,98 @@ pub fn grid_uncertainty(results: &GridResults, judged: &mut [Finding], resamples
         distance: DistanceIntervals::of(&distances),
     }
 }
+
+/// D of one grid minus D of a reference grid on the same seeds, paired by
+/// seed: resample i draws the same seeds in both.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Paired {
+    /// D here minus the reference's D; NaN when either grid lacks a term
+    /// of D (no runs for it): their D sum different terms.
+    pub difference: f64,
+    /// Its interval over the same seed resamples of both grids (`None` when
+    /// either grid lacks a term of D, on the grid or on a resample).
+    pub interval: Option<Interval>,
+}
+
+impl Paired {
+    /// The paired difference of `results` (with `samples`, its
+    /// [`distance_samples`]) from `reference` (with its own), which must
+    /// fly the same seeds.
+    pub fn of(
+        results: &GridResults,
+        samples: &[DistanceSample],
+        reference: &GridResults,
+        reference_samples: &[DistanceSample],
+    ) -> Paired {
+        let (d, r) = (Distance::of(results), Distance::of(reference));
+        let complete = d.missing.is_empty() && r.missing.is_empty();
+        let differences: Vec<f64> = samples
+            .iter()
+            .zip(reference_samples)
+            .map(|(a, b)| a.total - b.total)
+            .collect();
+        Paired {
+            difference: if complete { d.total - r.total } else { f64::NAN },
+            interval: complete.then(|| percentile_interval(&differences)).flatten(),
+        }
+    }
+
+    /// Whether the interval lies wholly below 0: closer to the paper than
+    /// the reference beyond seed noise.
+    pub fn closer(&self) -> bool {
+        self.interval.is_some_and(|i| i.hi < 0.0)
+    }
+
+    /// Whether the interval lies wholly above 0: farther beyond seed noise.
+    pub fn farther(&self) -> bool {
+        self.interval.is_some_and(|i| i.lo > 0.0)
+    }
+
+    /// The comparison in words, naming `reference`.
+    pub fn describe(&self, reference: &str) -> String {
+        let how = if self.closer() {
+            "closer to the paper than"
+        } else if self.farther() {
+            "farther from the paper than"
+        } else if self.interval.is_some() {
+            "not told apart on these seeds from"
+        } else {
+            "not comparable (a term of D lacks runs) with"
+        };
+        format!("{how} {reference}")
+    }
+}
+
+/// A grid's D against another grid's on the same seeds (`report --against`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Against {
+    /// The reference grid's folder.
+    pub reference: String,
+    /// Its D.
+    pub reference_total: f64,
+    /// D here minus its D, paired by seed.
+    pub paired: Paired,
+}
+
+impl Against {
+    /// `results` against `reference`; an error unless both fly the same seeds.
+    pub fn of(results: &GridResults, reference: &GridResults) -> anyhow::Result<Against> {
+        let (a, b) = (&results.spec, &reference.spec);
+        if a.seed_range() != b.seed_range() {
+            anyhow::bail!(
+                "{} flies seeds {} and {} seeds {}: a paired comparison needs the same seeds",
+                results.dir.display(),
+                a.seeds_label(),
+                reference.dir.display(),
+                b.seeds_label()
+            );
+        }
+        let samples = distance_samples(results, RESAMPLES);
+        let reference_samples = distance_samples(reference, RESAMPLES);
+        Ok(Against {
+            reference: reference.dir.display().to_string(),
+            reference_total: Distance::of(reference).total,
+            paired: Paired::of(results, &samples, reference, &reference_samples),
+        })
+    }
+}
