@@ -562,7 +562,7 @@ fn a_sweep_runs_a_run_its_variants_share_once_and_writes_the_files_a_run_of_each
     let config = tmp.path().join("start.toml");
     std::fs::write(&config, "[problem.tasks]\ntask2_spin = 0.5\n").unwrap();
     // Task 2's start changes task 2's runs only: task 1's are the base's.
-    let o = psa_esp(&[
+    let sweep_args = [
         "sweep",
         "--vary",
         "problem.tasks.task2_spin=-0.75,0.5",
@@ -578,7 +578,8 @@ fn a_sweep_runs_a_run_its_variants_share_once_and_writes_the_files_a_run_of_each
         "5",
         "--out",
         sweep.to_str().unwrap(),
-    ]);
+    ];
+    let o = psa_esp(&sweep_args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(
@@ -604,23 +605,17 @@ fn a_sweep_runs_a_run_its_variants_share_once_and_writes_the_files_a_run_of_each
     assert!(champion.contains("\"task2_spin\": 0.5"));
     // Resumed, nothing runs again; a shared run removed is written again from its source.
     std::fs::remove_dir_all(variant.join("runs/baseline/task1/seed2")).unwrap();
-    let o = psa_esp(&[
-        "sweep",
-        "--vary",
-        "problem.tasks.task2_spin=-0.75,0.5",
-        "--configs",
-        "baseline",
-        "--tasks",
-        "1,2",
-        "--seeds",
-        "2",
-        "--generations",
-        "3",
-        "--robustness-trials",
-        "5",
-        "--out",
-        sweep.to_str().unwrap(),
-    ]);
+    let o = psa_esp(&sweep_args);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("1 written from it now") && out.contains("0 run now"),
+        "{out}"
+    );
+    assert!(results(&variant) == shared);
+    // A shared run left unfinished (a process killed while it flew it) is written over.
+    std::fs::remove_file(variant.join("runs/baseline/task1/seed2/robustness.json")).unwrap();
+    std::fs::write(variant.join("runs/baseline/task1/seed2/records.csv"), "generation\n").unwrap();
+    let o = psa_esp(&sweep_args);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(
         out.contains("1 written from it now") && out.contains("0 run now"),

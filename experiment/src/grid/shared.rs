@@ -9,10 +9,13 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 
-use crate::grid::{run_dir, settings_read_by, GridSpec, RunKey, FINISHED_MARKER};
+use crate::grid::checkpoint::remove_checkpoint;
+use crate::grid::claim::{clear_stale, CLAIM_FILE};
+use crate::grid::{run_dir, run_status, settings_read_by, GridSpec, RunKey, RunStatus, FINISHED_MARKER};
 use crate::{RunConfig, RunFiles};
 use psa_sim::psa::NetworkFile;
 
@@ -66,15 +69,31 @@ pub fn shared_runs(grids: &[(PathBuf, GridSpec)]) -> Result<Vec<SharedRun>> {
 }
 
 /// Writes every shared run whose source is finished and whose own folder
-/// does not exist yet; returns how many it wrote.
-pub fn write_shared(grids: &[(PathBuf, GridSpec)], shared: &[SharedRun]) -> Result<usize> {
+/// is missing or unfinished (a killed run's, once its claim is stale by
+/// `claim_timeout` or its process is gone);
+/// returns how many it wrote.
+pub fn write_shared(grids: &[(PathBuf, GridSpec)], shared: &[SharedRun], claim_timeout: Duration) -> Result<usize> {
     let mut written = 0;
     for run in shared {
         let (source_dir, _) = &grids[run.source];
         let (dir, spec) = &grids[run.grid];
         let (source, target) = (run_dir(source_dir, &run.key), run_dir(dir, &run.key));
-        if target.exists() || !source.join(FINISHED_MARKER).is_file() {
+        if !source.join(FINISHED_MARKER).is_file() {
             continue;
+        }
+        match run_status(dir, spec, &run.key)? {
+            RunStatus::Finished => continue,
+            RunStatus::Missing => {}
+            // Left by a process killed while it flew the run itself (a
+            // build before shared runs, or a sweep defined otherwise):
+            // written over once its claim is stale, as a resume runs it again.
+            RunStatus::Unfinished => {
+                clear_stale(&target, claim_timeout)?;
+                if target.join(CLAIM_FILE).exists() {
+                    continue;
+                }
+                remove_checkpoint(&target)?;
+            }
         }
         let config = spec.run_config(run.key.config)?;
         write_from(&source, &target, &config)

@@ -553,22 +553,32 @@ pub fn sweep(
     for job in &jobs {
         crate::grid::replicate::prepare(job.dir, job.spec, Shard::ALL, Judge::Resume)?;
     }
-    let mut written = write_shared(&grids, &shared)?;
+    let mut written = write_shared(&grids, &shared, options.claim_timeout)?;
     let summaries = replicate_grids(&jobs, options, progress)?;
-    written += write_shared(&grids, &shared)?;
+    written += write_shared(&grids, &shared, options.claim_timeout)?;
     let seconds = summaries.first().map_or(0.0, |s| s.seconds);
+    // Every run of this process's shard, shared or not.
+    let mut before = 0;
+    let total = grids
+        .iter()
+        .map(|(_, grid)| {
+            let runs = grid.runs();
+            let mine = options.shard.after(before).select(&runs).len();
+            before += runs.len();
+            mine
+        })
+        .sum();
     let mut summary = SweepSummary {
         variants: variants.len(),
         shared: shared.len(),
         written_from_shared: written,
-        total: 0,
+        total,
         skipped: 0,
         ran: 0,
         held: Vec::new(),
         seconds,
     };
     for (variant, grid) in variants.iter().zip(summaries) {
-        summary.total += grid.total;
         summary.skipped += grid.skipped;
         summary.ran += grid.ran;
         summary
