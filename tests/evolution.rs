@@ -271,7 +271,18 @@ fn a_traced_evolve_is_the_untraced_run_and_traces_every_generation() {
     let traced = run("traced", Some(&trace));
     assert!(traced == run("plain", None), "tracing changed the run");
     let text = std::fs::read_to_string(&trace).unwrap();
-    let lines: Vec<&str> = text.lines().collect();
+    // The header names the run (docs/file-formats.md), then the CSV.
+    let header: Vec<&str> = text.lines().take_while(|l| l.starts_with('#')).collect();
+    assert_eq!(header.len(), 8, "{text}");
+    for line in [
+        "# task: 2",
+        "# configuration: baseline",
+        "# seed: 5",
+        "# generations: 80",
+    ] {
+        assert!(header.contains(&line), "{line}: {text}");
+    }
+    let lines: Vec<&str> = text.lines().skip(header.len()).collect();
     assert_eq!(lines.len(), 81, "{text}");
     assert!(lines[0].starts_with("generation,max,champion,subpops,burst,topology,top_first_pass"));
     // The trace's max and champion are the records' own, and bursts and
@@ -391,20 +402,38 @@ fn traces_summarises_each_folder_of_traces_as_a_group() {
         "{table}"
     );
     assert!(table.lines().any(|l| l.starts_with("| real | 1 |")), "{table}");
+    // The made traces have no header (as an earlier build wrote them): the
+    // table says so; the real one's names its run.
+    assert!(table.contains("- made: 2 of 2 traces of an earlier build"), "{table}");
+    assert!(
+        table.contains("- real: task 2; configuration baseline (config "),
+        "{table}"
+    );
     assert_eq!(std::fs::read_to_string(out.join("traces.md")).unwrap(), table);
     let csv = std::fs::read_to_string(out.join("traces.csv")).unwrap();
-    assert!(csv.contains("\nmade,a,8,3,4,1,0,1,1,0.2000,0.6000\n"), "{csv}");
-    assert!(csv.contains("\nmade,b,8,,0,0,0,0,0,,0.6000\n"), "{csv}");
+    assert!(csv.contains("\nmade,a,8,3,4,1,0,1,1,0.2000,0.6000,,,,,,\n"), "{csv}");
+    assert!(csv.contains("\nmade,b,8,,0,0,0,0,0,,0.6000,,,,,,\n"), "{csv}");
     assert_eq!(
-        csv.lines().filter(|l| l.starts_with("real,seed-1,20,")).count(),
+        csv.lines()
+            .filter(|l| l.starts_with("real,seed-1,20,")
+                && l.contains(",2,baseline,")
+                && l.ends_with(&format!(",1,20,{}", psa_sim::psa::settings::defaults::rows())))
+            .count(),
         1,
         "{csv}"
     );
+    let landing = std::fs::read_to_string(out.join("traces-landing.csv")).unwrap();
+    assert!(
+        landing.starts_with("group,generation,runs,found_by,landing\nreal,1,1,"),
+        "{landing}"
+    );
+    assert!(landing.contains("\nmade,3,2,1,1\nmade,4,2,1,0\n"), "{landing}");
     for figure in ["traces-landing.svg", "traces-landing.png"] {
         assert!(std::fs::metadata(out.join(figure)).unwrap().len() > 1000, "{figure}");
     }
 
     // A folder without traces, and a damaged trace, are refused by name.
+    let out = dir.path().join("summary-2");
     let empty = dir.path().join("empty");
     std::fs::create_dir_all(&empty).unwrap();
     let o = psa_esp(&["traces", empty.to_str().unwrap(), "--out", out.to_str().unwrap()]);

@@ -179,9 +179,11 @@ pub fn run_evolution(
     evolve(config, label, task, seed, dir, path, None, on_generation)
 }
 
-/// [`run_evolution`] with a trace ([`crate::trace`]) written to `trace`:
-/// the same run, bit for bit. ESP only (the hill-climber has no
-/// sub-populations to trace): refused otherwise.
+/// [`run_evolution`] with a trace ([`crate::trace`]) written to `trace`
+/// (atomically, after the run's own files): the same run, bit for bit.
+/// ESP only (the hill-climber has no sub-populations to trace): refused
+/// otherwise, as is a `trace` that could not be written
+/// ([`crate::trace::check_trace_path`]), before anything is written.
 #[allow(clippy::too_many_arguments)]
 pub fn run_evolution_traced(
     config: &RunConfig,
@@ -196,6 +198,7 @@ pub fn run_evolution_traced(
     if config.algorithm != Algorithm::Esp {
         anyhow::bail!("--trace follows ESP's sub-populations; the hill-climber has none to trace");
     }
+    crate::trace::check_trace_path(trace, dir)?;
     evolve(config, label, task, seed, dir, path, Some(trace), on_generation)
 }
 
@@ -216,12 +219,13 @@ fn evolve(
         started.record(record);
         on_generation(record);
     };
+    let mut traced = None;
     let result: RunResult = match (config.algorithm, trace) {
-        (Algorithm::Esp, Some(trace)) => {
+        (Algorithm::Esp, Some(_)) => {
             let esp = Esp::new(config.esp.clone(), seed).map_err(anyhow::Error::msg)?;
             let scoring = config.problem.scoring_for(task)?;
             let (result, lines) = crate::trace::traced_run(&esp, &evaluator, &scoring, task, on_generation)?;
-            crate::trace::write_trace(trace, &lines)?;
+            traced = Some(lines);
             result
         }
         (Algorithm::Esp, _) => Esp::new(config.esp.clone(), seed)
@@ -231,7 +235,13 @@ fn evolve(
             .map_err(anyhow::Error::msg)?
             .run(&evaluator, on_generation)?,
     };
-    started.finish(config, label, task, seed, &result)
+    let outcome = started.finish(config, label, task, seed, &result)?;
+    if let (Some(path), Some(lines)) = (trace, traced) {
+        let header = crate::trace::TraceHeader::of_run(config, label, task, seed)?;
+        crate::trace::write_trace(path, &header, &lines)
+            .with_context(|| format!("the run is written whole in {}, but not its trace", dir.display()))?;
+    }
+    Ok(outcome)
 }
 
 /// A run begun on disk: its folder made, `config.toml` written and

@@ -43,10 +43,12 @@ pub struct EvolveArgs {
     /// Output directory (default: evolve-<preset>-task<T>-seed<S>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Also write a per-generation trace CSV here (ESP only): each
-    /// generation's best network flown once on the scoring fitness
-    /// (first-pass landing or not) and its neurons' credit ranks; the run
-    /// is the same, bit for bit. An existing file is refused.
+    /// Also write a per-generation trace CSV here (ESP only): a header
+    /// naming the run, then each generation's best network flown once on
+    /// the scoring fitness (first-pass landing or not) and its neurons'
+    /// credit ranks; the run is the same, bit for bit. Checked before the
+    /// run: an existing file, a file of the run in --out, a non-UTF-8 name
+    /// or a folder that takes no file is refused.
     #[arg(long)]
     pub trace: Option<PathBuf>,
     /// Print the run summary as JSON.
@@ -95,12 +97,6 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
         anyhow::bail!(
             "output directory {} is not empty: results already written are never overwritten; choose another --out",
             out.display()
-        );
-    }
-    if let Some(trace) = args.trace.as_deref().filter(|t| t.symlink_metadata().is_ok()) {
-        anyhow::bail!(
-            "trace file {} exists: results already written are never overwritten; choose another --trace",
-            trace.display()
         );
     }
     let bar = progress_bar(
