@@ -119,7 +119,7 @@ fn rescoring_gives_the_robustness_results_of_a_grid_scored_that_way_from_the_sta
         .collect();
     let mean = (baseline_task1[0] + baseline_task1[1]) / 2.0;
     assert!(
-        md.contains(&format!("| 1 | 2 | {mean:.1} |")),
+        md.contains(&format!("| 1 | 2 | {mean:.1} [")),
         "Table 1 task 1 should be {mean:.1}:\n{md}"
     );
 }
