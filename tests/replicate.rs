@@ -603,23 +603,20 @@ fn a_sweep_runs_a_run_its_variants_share_once_and_writes_the_files_a_run_of_each
     );
     let champion = std::fs::read_to_string(variant.join("runs/baseline/task1/seed1/champion.json")).unwrap();
     assert!(champion.contains("\"task2_spin\": 0.5"));
-    // Resumed, nothing runs again; a shared run removed is written again from its source.
+    // Resumed, nothing runs again: the one shared run gone is written again from its source.
+    let rewritten_once = || {
+        let o = psa_esp(&sweep_args);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            out.contains("1 written from it now") && out.contains("0 run now"),
+            "{out}"
+        );
+        assert!(results(&variant) == shared);
+    };
     std::fs::remove_dir_all(variant.join("runs/baseline/task1/seed2")).unwrap();
-    let o = psa_esp(&sweep_args);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        out.contains("1 written from it now") && out.contains("0 run now"),
-        "{out}"
-    );
-    assert!(results(&variant) == shared);
+    rewritten_once();
     // A shared run left unfinished (a process killed while it flew it) is written over.
     std::fs::remove_file(variant.join("runs/baseline/task1/seed2/robustness.json")).unwrap();
     std::fs::write(variant.join("runs/baseline/task1/seed2/records.csv"), "generation\n").unwrap();
-    let o = psa_esp(&sweep_args);
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        out.contains("1 written from it now") && out.contains("0 run now"),
-        "{out}"
-    );
-    assert!(results(&variant) == shared);
+    rewritten_once();
 }

@@ -254,18 +254,20 @@ pub fn write_report(dir: &Path, format: ReportFormat) -> Result<ReportOutcome> {
 /// in `against` (which must fly the same seeds; [`uncertainty::Against`]).
 pub fn write_report_against(dir: &Path, format: ReportFormat, against: Option<&Path>) -> Result<ReportOutcome> {
     let results = GridResults::load(dir)?;
-    let against = match against {
-        Some(reference) => {
-            let reference = GridResults::load(reference).context("the grid of --against")?;
-            Some(uncertainty::Against::of(&results, &reference)?)
-        }
-        None => None,
-    };
+    let reference = against
+        .map(|path| GridResults::load(path).context("the grid of --against"))
+        .transpose()?;
+    let mut report = Report::from_results(&results);
+    if let Some(reference) = &reference {
+        report.against = Some(uncertainty::Against::of(
+            &results,
+            &report.uncertainty.samples,
+            reference,
+        )?);
+    }
     // What an earlier report, killed while writing, left.
     psa_sim::io::remove_stale_temporaries(dir);
     psa_sim::io::remove_stale_temporaries(&dir.join("figures"));
-    let mut report = Report::from_results(&results);
-    report.against = against;
     let (links, figures, figure_problems) = figures::write_figures(&results, &dir.join("figures"));
     report.figures = links;
     report.figure_problems = figure_problems.clone();

@@ -18,9 +18,8 @@ use psa_sim::named::Named;
 use serde::{Deserialize, Serialize};
 
 use crate::grid::replicate::{replicate_grids, GridJob, GridProgress, HeldRun, ReplicateOptions};
-use crate::grid::shard::Shard;
 use crate::grid::shared::{shared_runs, write_shared};
-use crate::grid::{GridSpec, Judge, RunKey};
+use crate::grid::{GridSpec, RunKey};
 use crate::RunConfig;
 
 /// The `format` of `sweep.json`.
@@ -528,8 +527,7 @@ pub fn sweep(
             .with_context(|| format!("variant {}", variant.name))?;
         grids.push((variant_dir(dir, variant), grid));
     }
-    // Runs a variant shares with an earlier one run once, there; the
-    // others are written from them (those finished before this process too).
+    // Runs a variant shares with an earlier one run once, there.
     let shared = shared_runs(&grids)?;
     let elsewhere: Vec<Vec<RunKey>> = (0..grids.len())
         .map(|g| shared.iter().filter(|s| s.grid == g).map(|s| s.key).collect())
@@ -549,13 +547,10 @@ pub fn sweep(
             }
         })
         .collect();
-    // Each variant's folder and grid.json exist before a shared run is written into it.
-    for job in &jobs {
-        crate::grid::replicate::prepare(job.dir, job.spec, Shard::ALL, Judge::Resume)?;
-    }
-    let mut written = write_shared(&grids, &shared, options.claim_timeout)?;
+    // replicate_grids prepares every variant's folder; the shared runs are
+    // then written from their sources (those finished before this process too).
     let summaries = replicate_grids(&jobs, options, progress)?;
-    written += write_shared(&grids, &shared, options.claim_timeout)?;
+    let written = write_shared(&grids, &shared, options.claim_timeout)?;
     let seconds = summaries.first().map_or(0.0, |s| s.seconds);
     // Every run of this process's shard, shared or not.
     let mut before = 0;

@@ -16,7 +16,7 @@ use super::findings::Verdict;
 use super::paper::PAPER_TASKS;
 use super::render::{num, with_interval};
 use super::tables::Report;
-use super::uncertainty::{distance_samples, DistanceIntervals, DistanceSample, Paired, RESAMPLES};
+use super::uncertainty::{DistanceIntervals, DistanceSample, Paired};
 use super::{GridResults, Metric};
 use crate::grid::grid_file;
 use crate::grid::sweep::{variant_dir, SweepSpec};
@@ -89,8 +89,14 @@ fn mean(values: &[f64]) -> f64 {
 }
 
 impl VariantSummary {
-    fn of(name: String, settings: Vec<(String, String)>, results: &GridResults) -> VariantSummary {
-        let report = Report::from_results(results);
+    /// The summary of a variant's grid, and D on each of its seed resamples.
+    fn of(
+        name: String,
+        settings: Vec<(String, String)>,
+        results: &GridResults,
+    ) -> (VariantSummary, Vec<DistanceSample>) {
+        let mut report = Report::from_results(results);
+        let samples = std::mem::take(&mut report.uncertainty.samples);
         let tasks = &results.spec.tasks;
         let per_run = |config| mean(&results.values(config, tasks, Metric::Bursts));
         let ratio = |metric: Metric| {
@@ -102,7 +108,7 @@ impl VariantSummary {
             let clean: Vec<f64> = tested.iter().map(|r| r.robustness.clean).collect();
             mean(&robust) / mean(&clean)
         };
-        VariantSummary {
+        let summary = VariantSummary {
             name,
             settings,
             runs: (results.runs.len(), results.spec.runs().len()),
@@ -114,7 +120,8 @@ impl VariantSummary {
             distance: report.distance,
             distance_intervals: report.uncertainty.distance,
             paired: None,
-        }
+        };
+        (summary, samples)
     }
 }
 
@@ -129,6 +136,7 @@ impl SweepReport {
         let sweep = SweepSpec::load(dir)?;
         let mut variants = Vec::new();
         let mut grids = Vec::new();
+        let mut samples: Vec<Vec<DistanceSample>> = Vec::new();
         for variant in sweep.variants() {
             let folder = variant_dir(dir, &variant);
             // A variant the sweep has not reached yet counts as a grid without runs.
@@ -143,12 +151,13 @@ impl SweepReport {
                     problems: Vec::new(),
                 }
             };
-            variants.push(VariantSummary::of(variant.name, variant.settings, &results));
+            let (summary, own) = VariantSummary::of(variant.name, variant.settings, &results);
+            variants.push(summary);
+            samples.push(own);
             grids.push(results);
         }
         // Every variant flies the same seeds: resample i draws the same
         // seeds in each, so the differences pair by seed.
-        let samples: Vec<Vec<DistanceSample>> = grids.iter().map(|g| distance_samples(g, RESAMPLES)).collect();
         if let Some((reference, others)) = samples.split_first() {
             for ((variant, own), grid) in variants.iter_mut().skip(1).zip(others).zip(&grids[1..]) {
                 variant.paired = Some(Paired::of(grid, own, &grids[0], reference));
@@ -197,23 +206,16 @@ impl SweepReport {
     /// words: only those whose paired interval of ΔD lies below 0; the
     /// others cannot be told apart from it on these seeds, or are farther.
     pub fn verdict(&self) -> String {
-        let closer: Vec<&VariantSummary> = self
-            .variants
-            .iter()
-            .filter(|v| v.paired.is_some_and(|p| p.closer()))
-            .collect();
-        let farther: Vec<&str> = self
-            .variants
-            .iter()
-            .filter(|v| v.paired.is_some_and(|p| p.farther()))
-            .map(|v| v.name.as_str())
-            .collect();
-        let undecided: Vec<&str> = self
-            .variants
-            .iter()
-            .filter(|v| v.paired.is_some_and(|p| !p.closer() && !p.farther()))
-            .map(|v| v.name.as_str())
-            .collect();
+        // Every compared variant in one of three groups by its interval.
+        let (mut closer, mut farther, mut undecided) = (Vec::new(), Vec::new(), Vec::new());
+        for v in &self.variants {
+            match v.paired {
+                Some(p) if p.closer() => closer.push(v),
+                Some(p) if p.farther() => farther.push(v.name.as_str()),
+                Some(_) => undecided.push(v.name.as_str()),
+                None => {}
+            }
+        }
         let list = |names: &[&str]| {
             if names.is_empty() {
                 "none".to_string()

@@ -106,6 +106,20 @@ fn grid() -> (tempfile::TempDir, GridSpec) {
     (dir, spec)
 }
 
+/// [`spec`] on all three tasks (every term of D has runs), written.
+fn grid_of_all_tasks() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = GridSpec {
+        tasks: Task::VARIANTS.to_vec(),
+        ..spec()
+    };
+    spec.save(dir.path()).unwrap();
+    for key in spec.runs() {
+        write_run(dir.path(), &spec, &key);
+    }
+    dir
+}
+
 fn table<'a>(report: &'a Report, id: &str) -> &'a Table {
     report.tables.iter().find(|t| t.id == id).unwrap()
 }
@@ -441,15 +455,7 @@ fn distance_terms_follow_their_definitions() {
 
 #[test]
 fn the_burst_ratio_is_max_credit_over_baseline_in_the_se_of_two_counts() {
-    let dir = tempfile::tempdir().unwrap();
-    let spec = GridSpec {
-        tasks: Task::VARIANTS.to_vec(),
-        ..spec()
-    };
-    spec.save(dir.path()).unwrap();
-    for key in spec.runs() {
-        write_run(dir.path(), &spec, &key);
-    }
+    let dir = grid_of_all_tasks();
     let d = Distance::of(&GridResults::load(dir.path()).unwrap());
     let ratio = d.terms.iter().find(|t| t.part == Part::BurstRatio).unwrap();
     // Max credit never bursts here; the baseline bursts s times in seed s.
@@ -484,15 +490,7 @@ fn near_quantile(x: f64, sorted: &[f64], q: f64) -> bool {
 fn intervals_and_replication_rates_match_a_direct_computation() {
     use super::uncertainty::{seed_draws, LEVEL, RESAMPLES};
     // All three tasks, so that every term of D has runs.
-    let dir = tempfile::tempdir().unwrap();
-    let spec = GridSpec {
-        tasks: Task::VARIANTS.to_vec(),
-        ..spec()
-    };
-    spec.save(dir.path()).unwrap();
-    for key in spec.runs() {
-        write_run(dir.path(), &spec, &key);
-    }
+    let dir = grid_of_all_tasks();
     let results = GridResults::load(dir.path()).unwrap();
     let report = Report::from_results(&results);
     assert!(report.distance.missing.is_empty());
@@ -571,20 +569,8 @@ fn intervals_and_replication_rates_match_a_direct_computation() {
 
 #[test]
 fn a_grid_against_another_on_the_same_seeds_is_compared_paired_and_on_other_seeds_refused() {
-    // All three tasks: every term of D has runs.
-    let spec = GridSpec {
-        tasks: Task::VARIANTS.to_vec(),
-        ..spec()
-    };
-    let written = || {
-        let dir = tempfile::tempdir().unwrap();
-        spec.save(dir.path()).unwrap();
-        for key in spec.runs() {
-            write_run(dir.path(), &spec, &key);
-        }
-        dir
-    };
-    let (dir, same) = (written(), written());
+    let (dir, same) = (grid_of_all_tasks(), grid_of_all_tasks());
+    let spec = GridSpec::load(dir.path()).unwrap();
     let outcome = write_report_against(dir.path(), ReportFormat::Csv, Some(same.path())).unwrap();
     // The same runs: ΔD is 0 on every resample, so not told apart.
     assert!(

@@ -229,6 +229,9 @@ pub struct GridUncertainty {
     pub level: f64,
     /// The intervals of D and its parts.
     pub distance: DistanceIntervals,
+    /// D on each resample, in resample order (for paired comparisons).
+    #[serde(skip)]
+    pub samples: Vec<DistanceSample>,
 }
 
 /// D on each of `resamples` seed resamples of `results` (resample `i` is
@@ -285,6 +288,7 @@ pub fn grid_uncertainty(results: &GridResults, judged: &mut [Finding], resamples
         seed: RESAMPLE_SEED,
         level: LEVEL,
         distance: DistanceIntervals::of(&distances),
+        samples: distances,
     }
 }
 
@@ -361,8 +365,9 @@ pub struct Against {
 }
 
 impl Against {
-    /// `results` against `reference`; an error unless both fly the same seeds.
-    pub fn of(results: &GridResults, reference: &GridResults) -> anyhow::Result<Against> {
+    /// `results` (with `samples`, its [`distance_samples`]) against
+    /// `reference`; an error unless both fly the same seeds.
+    pub fn of(results: &GridResults, samples: &[DistanceSample], reference: &GridResults) -> anyhow::Result<Against> {
         let (a, b) = (&results.spec, &reference.spec);
         if a.seed_range() != b.seed_range() {
             anyhow::bail!(
@@ -373,12 +378,11 @@ impl Against {
                 b.seeds_label()
             );
         }
-        let samples = distance_samples(results, RESAMPLES);
-        let reference_samples = distance_samples(reference, RESAMPLES);
+        let reference_samples = distance_samples(reference, samples.len());
         Ok(Against {
             reference: reference.dir.display().to_string(),
             reference_total: Distance::of(reference).total,
-            paired: Paired::of(results, &samples, reference, &reference_samples),
+            paired: Paired::of(results, samples, reference, &reference_samples),
         })
     }
 }
