@@ -178,6 +178,37 @@ fn the_clockwise_start_file_repeats_the_records_of_sweeps_s33_to_s35_byte_for_by
     }
 }
 
+#[test]
+fn the_noiseless_bias_file_repeats_the_records_of_sweeps_s41_to_s46_byte_for_byte() {
+    // Recorded by build 55317a7, whose defaults the file pins: input noise
+    // on the six sensed inputs, not on the bias. Evolution under input
+    // noise (Table 3's configuration) is the run that reads it.
+    let dir = tempfile::tempdir().unwrap();
+    let noisy = |name: &str, text: &str| {
+        let path = dir.path().join(name);
+        assert!(text.contains("\n[problem]\n") && text.contains("\n[problem.noise]\n"));
+        let text = text
+            .replace("\n[problem]\n", "\n[problem]\ntrials = 3\n")
+            .replace("\n[problem.noise]\n", "\n[problem.noise]\ninput_sd = 0.05\n");
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let pinned = noisy(
+        "noiseless-bias.toml",
+        &std::fs::read_to_string(repo("configs/noiseless-bias.toml")).unwrap(),
+    );
+    let defaults = noisy("defaults.toml", "\n[problem]\n\n[problem.noise]\n");
+    for task in ["1", "2", "3"] {
+        assert_repeats_one_golden_record(&pinned, "noiseless-bias", "baseline", "input-noise", task);
+        // Today's defaults put the noise on the bias too: another run.
+        let recorded = std::fs::read(repo(&format!("tests/golden/noiseless-bias/input-noise-t{task}.csv"))).unwrap();
+        assert!(
+            golden_run_records(Some(&defaults), "baseline", task) != recorded,
+            "task {task}: the defaults did not move"
+        );
+    }
+}
+
 /// The `records.csv` of the golden records' run (seed 7, 120 generations,
 /// native) of `preset` on `task`, with `config` laid over it if given.
 fn golden_run_records(config: Option<&Path>, preset: &str, task: &str) -> Vec<u8> {
@@ -374,13 +405,15 @@ fn the_text_model_sets_exactly_the_settings_the_papers_words_decide_each_with_it
         .map(|(key, _, _)| key)
         .collect();
     changed.sort();
+    // Noise on the bias too (`noise.on_bias`) is the text's reading and
+    // the default: the file sets it, with its words, and changes nothing.
+    assert!(text.contains("\non_bias = true\n"));
     assert_eq!(
         changed,
         [
             "problem.fitness.scoring",
             "problem.fitness.slowing",
             "problem.fitness.state",
-            "problem.noise.on_bias",
             "problem.sensors.angular_velocity_scale",
             "problem.sensors.heading_input",
             "problem.sensors.heading_scale",

@@ -204,16 +204,18 @@ fn injected_noise_has_the_configured_mean_and_sd() {
     };
     let mut source = NoiseSource::new(9);
     let n = 40_000;
-    let mut samples = Vec::with_capacity(n * 6);
+    let mut samples = Vec::with_capacity(n * 7);
     for _ in 0..n {
         let mut inputs = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
         noise.perturb_inputs(&mut inputs, &mut source);
-        assert_eq!(inputs[6], 1.0, "the bias gets no noise");
+        // The bias (1) gets its noise too: on "each input neuron".
+        assert_ne!(inputs[6], 1.0, "the bias gets noise by default");
         samples.extend_from_slice(&inputs[..6]);
+        samples.push(inputs[6] - 1.0);
     }
     let mean = samples.iter().sum::<f64>() / samples.len() as f64;
     let sd = (samples.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (samples.len() - 1) as f64).sqrt();
-    // Standard errors: mean 0.05 / sqrt(240000) = 1e-4; sd about 7e-5.
+    // Standard errors: mean 0.05 / sqrt(280000) = 1e-4; sd about 7e-5.
     assert!(mean.abs() < 5e-4, "mean {mean}");
     assert!((sd - 0.05).abs() < 5e-4, "sd {sd}");
     // Outputs: noise only (the trial clamps afterwards), half of it below 0 at 0.

@@ -68,7 +68,8 @@ pub enum NoiseStage {
 /// inputs then lie about 0.75 to 3.1 (the box's 0.2 m, 0.4 m/s, a heading
 /// error of up to 2 pi, 1.5 rad/s), 15 to 63 times the noise (sd 0.05).
 /// The text's "about two orders of magnitude" (§5.1) reads as factor 1
-/// (30 to 126 times): the fit moved away from it (configs/text.toml).
+/// (30 to 126 times): the fit, with task 2's start, moved away from it
+/// (configs/text.toml; docs/model.md, "How sure the fit is").
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSettings {
@@ -199,20 +200,32 @@ impl SensorSettings {
 
 /// Gaussian white noise on the network's inputs (the bias too, if
 /// `on_bias`) and outputs, drawn from a [`NoiseSource`](crate::numeric::NoiseSource) per trial.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseSettings {
     /// Standard deviation of the noise on every input (the bias too with
-    /// `on_bias`, a `[chosen]` reading). `[paper]` 0 (0.05 in robustness tests)
+    /// `on_bias`). `[paper]` 0 (0.05 in robustness tests)
     pub input_sd: f64,
     /// Standard deviation of the noise on every output, before clamping to [0, 1]. `[paper]` 0
     pub output_sd: f64,
     /// Whether the input noise reaches the bias unit too ("added to each
-    /// input neuron"; the bias is one of the seven input units). `[chosen]` false
+    /// input neuron", §5.1; the bias is one of the "7 input units", §2).
+    /// `[paper]` true
     pub on_bias: bool,
     /// Where the input noise enters: on the scaled inputs or on what the
     /// sensors measure, before scaling. `[chosen]` scaled
     pub stage: NoiseStage,
+}
+
+impl Default for NoiseSettings {
+    fn default() -> Self {
+        NoiseSettings {
+            input_sd: 0.0,
+            output_sd: 0.0,
+            on_bias: true,
+            stage: NoiseStage::default(),
+        }
+    }
 }
 
 impl NoiseSettings {

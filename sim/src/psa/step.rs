@@ -177,6 +177,7 @@ mod tests {
     fn input_noise_reaches_the_bias_only_when_asked() {
         let mut s = Settings::default();
         s.noise.input_sd = 0.05;
+        s.noise.on_bias = false;
         let read = |s: &Settings| {
             sense::<f64, true>(
                 s.step(),

@@ -117,6 +117,7 @@ pub const CHANGES: &[Change] = &[
     changed("problem.sensors.heading_scale", "", "0.5"),
     first("problem.sensors.angular_velocity_scale", "1.0"),
     changed("problem.sensors.angular_velocity_scale", "", "0.5"),
+    changed("problem.noise.on_bias", "", "true"),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.
@@ -327,8 +328,8 @@ mod tests {
         assert!(err.contains(wrap) && err.contains("0123456789abcdef"), "{err}");
         // A key whose default never changed needs no placement.
         assert_eq!(
-            value_at("problem.noise.on_bias", &at("unknown")).unwrap(),
-            Some(false.into())
+            value_at("problem.tasks.task2_velocity", &at("unknown")).unwrap(),
+            Some(serde_json::json!([0.0, 0.0]))
         );
         assert_eq!(value_at("problem.steps", &at("unknown")).unwrap(), None);
     }

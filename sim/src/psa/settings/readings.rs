@@ -192,7 +192,7 @@ pub const READINGS: &[Reading] = &[
     Reading {
         key: "noise.on_bias",
         doc: "whether the input noise reaches the bias unit too (one of the seven input units)",
-        tag: Tag::Chosen,
+        tag: Tag::Paper,
         define: Some(Define {
             name: "PSA_BIAS_NOISE",
             on: |s| s.noise.on_bias,
@@ -204,7 +204,7 @@ pub const READINGS: &[Reading] = &[
                 if s.noise.on_bias { "yes" } else { "no" }
             )]
         }),
-        set_test_value: |s| s.noise.on_bias = true,
+        set_test_value: |s| s.noise.on_bias = false,
     },
     Reading {
         key: "noise.stage",
