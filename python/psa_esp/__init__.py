@@ -46,7 +46,6 @@ from ._native import (
     resolve_config,
     welch,
 )
-from .env import DEFAULT_STEPS
 from .errors import *  # noqa: F401,F403
 
 TASKS = (1, 2, 3)
@@ -89,7 +88,9 @@ for _task in TASKS:
             id=_id,
             entry_point="psa_esp.env:PsaEnv",
             kwargs={"task": _task},
-            max_episode_steps=DEFAULT_STEPS,
+            # No TimeLimit: an episode ends with its trial, whose length
+            # the configuration gives (`problem.steps`).
+            max_episode_steps=None,
         )
 
 __all__ = [

@@ -17,8 +17,9 @@
   last step, the bits :func:`psa_esp.evaluate` gives for one trial);
   ``info["state"]`` is the body's true state: x, y (m), heading (rad),
   vx, vy (m/s), omega (rad/s);
-- an episode is one trial: truncated after its steps (500 by default, the
-  spec's ``max_episode_steps``);
+- an episode is one trial: the environment truncates it after the
+  configuration's ``problem.steps`` (500 by default) itself, whatever
+  wraps it (the registered environments carry no ``TimeLimit``);
 - ``reset(seed=S)`` starts the trial as ``psa-esp replay --seed S`` starts
   its first: the paper's start, or a random one when the configuration
   (or ``random_init=True``) asks for it;
@@ -37,9 +38,6 @@ from gymnasium import spaces
 
 from ._native import INPUTS, OUTPUTS, Trial
 
-#: The trial's length in steps under the default configuration: the
-#: registered environments' ``max_episode_steps``.
-DEFAULT_STEPS = 500
 
 
 class PsaEnv(gymnasium.Env):
@@ -69,12 +67,6 @@ class PsaEnv(gymnasium.Env):
     def reset(self, *, seed=None, options=None):
         """Starts a trial. With ``seed``, the trial ``replay --seed seed``
         flies first; without, one drawn from the environment's generator."""
-        limit = self.spec.max_episode_steps if self.spec is not None else None
-        if limit is not None and limit != self.steps:
-            raise ValueError(
-                f"the environment's spec truncates episodes at {limit} steps but its trials last {self.steps}: "
-                f"pass max_episode_steps={self.steps} to gymnasium.make"
-            )
         super().reset(seed=seed)
         trial_seed = int(seed) if seed is not None else int(self.np_random.integers(0, 2**63))
         observation = self._trial.reset(trial_seed)

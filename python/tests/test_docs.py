@@ -33,10 +33,12 @@ def test_readme_documents_observation_action_and_state_order():
         assert words in README, words
 
 
-def test_the_spec_gives_the_episode_length_and_the_space_its_bounds():
+def test_the_environment_gives_the_episode_length_and_the_space_its_bounds():
     for task in psa_esp.TASKS:
         env = gymnasium.make(f"psa_esp/Task{task}-v0")
-        assert env.spec.max_episode_steps == env.unwrapped.steps == 500
+        # The environment truncates its episodes itself: no TimeLimit.
+        assert env.spec.max_episode_steps is None
+        assert env.unwrapped.steps == 500
     space = PsaEnv(1).observation_space
     assert space.low[6] == space.high[6] == 1.0, "the bias is 1"
     assert np.isfinite(space.low[4]) and np.isfinite(space.high[4]), "the heading input is wrapped"

@@ -53,6 +53,22 @@ def test_a_trial_flown_step_by_step_scores_what_evaluate_gives(champions, task, 
     assert expected > 0
 
 
+@pytest.mark.parametrize("steps", [800, 120])
+def test_an_episode_lasts_the_configured_steps_made_through_gymnasium(steps):
+    # Longer and shorter trials than the default 500: the episode ends with
+    # the trial, whatever the registration or gymnasium's wrappers.
+    env = gymnasium.make("psa_esp/Task1-v0", config={"problem": {"steps": steps}})
+    env.reset(seed=1)
+    flown = 0
+    while True:
+        _, _, terminated, truncated, _ = env.step(np.zeros(4))
+        flown += 1
+        assert not terminated
+        if truncated:
+            break
+    assert flown == steps == env.unwrapped.steps
+
+
 def test_reset_by_seed_is_deterministic_and_random_starts_differ():
     env = PsaEnv(1, random_init=True)
     first, info = env.reset(seed=3)
