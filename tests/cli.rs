@@ -227,6 +227,88 @@ fn spin_damper() -> esp_neuroevolution::network::Network {
 }
 
 #[test]
+fn replay_flies_the_config_files_noise_trials_and_starts_and_an_option_wins_over_the_file() {
+    use psa_sim::psa::{NetworkFile, PsaSettings, Task};
+    let dir = tempfile::tempdir().unwrap();
+    let net_path = dir.path().join("damper.json");
+    let mut model = PsaSettings::default();
+    model.tasks.task1_spin = 1.0;
+    model.sensors.angular_velocity_scale = 1.0;
+    NetworkFile::new(
+        &spin_damper(),
+        Task::StopRotation,
+        &model,
+        &psa_experiment::build_info(),
+        serde_json::Map::new(),
+    )
+    .save(&net_path)
+    .unwrap();
+    let config = dir.path().join("noisy.toml");
+    std::fs::write(
+        &config,
+        "[problem]\ntrials = 4\nbackend = \"native\"\n\n[problem.noise]\ninput_sd = 0.05\n",
+    )
+    .unwrap();
+    let replay = |extra: &[&str]| -> serde_json::Value {
+        let out = dir.path().join("replay");
+        let mut args = vec![
+            "replay",
+            net_path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--json",
+        ];
+        args.extend(extra);
+        let o = psa_esp(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_str(&stdout(&o)).unwrap()
+    };
+    // The file's noise, trials and backend fly, as the same options would.
+    let from_file = replay(&["--config", config.to_str().unwrap()]);
+    let from_options = replay(&["--input-noise", "0.05", "--trials", "4", "--backend", "native"]);
+    assert_eq!(from_file["input_noise"], 0.05);
+    assert_eq!(from_file["trials"], 4);
+    assert_eq!(from_file["backend"], "native");
+    assert!(from_file["fitness_percent_sd"].as_f64().unwrap() > 0.0, "{from_file}");
+    assert_eq!(
+        from_file["fitness_percent_per_trial"],
+        from_options["fitness_percent_per_trial"]
+    );
+    // An option given wins over the file: no noise, one trial.
+    let quiet = replay(&[
+        "--config",
+        config.to_str().unwrap(),
+        "--input-noise",
+        "0",
+        "--trials",
+        "1",
+    ]);
+    assert_eq!(quiet["input_noise"], 0.0);
+    assert_eq!(
+        quiet["fitness_percent_per_trial"],
+        replay(&["--backend", "native"])["fitness_percent_per_trial"]
+    );
+    // A file's random starts on a task without them are refused, naming the file's setting.
+    std::fs::write(&config, "[problem]\nrandom_init = true\n").unwrap();
+    let o = psa_esp(&[
+        "replay",
+        net_path.to_str().unwrap(),
+        "--task",
+        "2",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        dir.path().join("r2").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("problem.random_init") && stderr(&o).contains("task 2"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
     use psa_sim::psa::{NetworkFile, PsaSettings, Task};
     let dir = tempfile::tempdir().unwrap();

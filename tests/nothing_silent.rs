@@ -962,6 +962,43 @@ fn a_sweep_of_a_setting_no_task_of_the_grid_reads_is_refused_naming_it() {
 }
 
 #[test]
+fn a_sweep_one_at_a_time_or_of_the_other_algorithms_settings_is_refused_when_its_variants_run_the_same_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let one_at_a_time = |vary: &'static [&'static str]| {
+        let mut args = tiny_sweep(&out, "1", vary);
+        args.extend(["--mode", "one-at-a-time"]);
+        args
+    };
+    // Task 1 reads no task-2 start: each value runs the base's runs.
+    for vary in [
+        &["problem.tasks.task2_spin=1.0,-1.5"][..],
+        &["problem.tasks.task2_spin=1.0"],
+    ] {
+        refused(
+            &psa_esp(&one_at_a_time(vary)),
+            &["problem.tasks.task2_spin", "changes nothing"],
+        );
+        assert!(!out.exists(), "{vary:?}: nothing written");
+    }
+    // ESP reads no hill-climber setting, the hill-climber no ESP one.
+    for (vary, config, key) in [
+        ("hill_climb.alpha=0.3,1.0", "baseline", "hill_climb.alpha"),
+        ("esp.stagnation=20,30", "hill-climb", "esp.stagnation"),
+    ] {
+        let mut args = tiny_sweep(&out, "1", &[vary]);
+        let at = args.iter().position(|a| *a == "--configs").unwrap();
+        args[at + 1] = config;
+        refused(&psa_esp(&args), &[key, "changes nothing"]);
+        assert!(!out.exists(), "{vary}: nothing written");
+    }
+    // The base's own value, named, is a row of its own; a value that
+    // changes a run is not refused.
+    let ok = psa_esp(&one_at_a_time(&["problem.tasks.task1_spin=1.0,2.0"]));
+    assert!(ok.status.success(), "{}", stderr(&ok));
+}
+
+#[test]
 fn a_task_2_run_of_another_start_whose_build_cannot_be_placed_is_not_counted() {
     let dir = tempfile::tempdir().unwrap();
     let grid = task_2_grid(dir.path(), "grid");

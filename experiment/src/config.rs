@@ -194,6 +194,16 @@ impl RunConfig {
             .with_context(|| format!("configuration {}", path.display()))
     }
 
+    /// The dotted keys (`problem.noise.input_sd`) a configuration file
+    /// sets, whatever their values.
+    pub fn keys_set_by(path: &Path) -> Result<Vec<String>> {
+        let text = psa_sim::io::read_input(path, "configuration")?;
+        let table: toml::Table = toml::from_str(&text).with_context(|| format!("configuration {}", path.display()))?;
+        let mut leaves = Vec::new();
+        crate::grid::leaves(&table, "", &mut leaves);
+        Ok(leaves.into_iter().map(|(key, _)| key).collect())
+    }
+
     /// The configuration as TOML.
     pub fn to_toml(&self) -> Result<String> {
         Ok(toml::to_string(self)?)

@@ -23,26 +23,33 @@ pub struct ReplayArgs {
     /// Task 1, 2 or 3 (default: the task the network was evolved for).
     #[arg(long)]
     pub task: Option<Task>,
-    /// Physics backend.
-    #[arg(long, value_parser = choice::<BackendKind>(), default_value_t = BackendKind::Ode)]
-    pub backend: BackendKind,
-    /// Standard deviation of Gaussian noise on every input but the bias.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub input_noise: f64,
-    /// Standard deviation of Gaussian noise on every output (before clamping).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub output_noise: f64,
-    /// Random initial conditions (tasks 1 and 3).
+    /// Physics backend [default: the `--config` file's `problem.backend`, else ode].
+    #[arg(long, value_parser = choice::<BackendKind>())]
+    pub backend: Option<BackendKind>,
+    /// Standard deviation of Gaussian noise on every input (the bias too,
+    /// unless the model sets `noise.on_bias = false`) [default: the
+    /// `--config` file's `problem.noise.input_sd`, else 0].
+    #[arg(long, allow_negative_numbers = true)]
+    pub input_noise: Option<f64>,
+    /// Standard deviation of Gaussian noise on every output (before
+    /// clamping) [default: the `--config` file's `problem.noise.output_sd`, else 0].
+    #[arg(long, allow_negative_numbers = true)]
+    pub output_noise: Option<f64>,
+    /// Random initial conditions (tasks 1 and 3); also where the `--config`
+    /// file sets `problem.random_init = true`.
     #[arg(long)]
     pub random_init: bool,
-    /// Number of trials (at most 1,000,000); the fitness is their mean.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=MAX_TRIALS))]
-    pub trials: u64,
+    /// Number of trials (at most 1,000,000); the fitness is their mean
+    /// [default: the `--config` file's `problem.trials`, else 1].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_TRIALS))]
+    pub trials: Option<u64>,
     /// Seed of the noise and random initial conditions.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// A TOML file of settings (as for `evolve --config`) laid over the
-    /// model the network was evolved under; its `problem` table applies.
+    /// model the network was evolved under; its `problem` table applies,
+    /// noise, trials, random starts and backend included; an option given
+    /// on the command line wins over the file.
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Fly the network on this build's default model instead of the one
@@ -128,27 +135,89 @@ fn model(args: &ReplayArgs, file: &NetworkFile) -> Result<PsaSettings> {
     }
 }
 
-/// Runs `replay`.
-pub fn run(args: ReplayArgs) -> Result<i32> {
-    check_as("noise.input_sd", "--input-noise", args.input_noise).map_err(anyhow::Error::msg)?;
-    check_as("noise.output_sd", "--output-noise", args.output_noise).map_err(anyhow::Error::msg)?;
-    let (file, network) = NetworkFile::load(&args.network)?;
-    let task = args.task.unwrap_or(file.task);
-    if args.random_init && !task.has_random_init() {
-        bail!("--random-init: task {task} has no random-initialisation variant (tasks 1 and 3 have)");
+/// The settings of the `--config` file's `problem` table that replay has
+/// options for, as the file sets them (after the model it lays them on).
+#[derive(Debug, Default, PartialEq)]
+struct FileSets {
+    input_sd: bool,
+    output_sd: bool,
+    trials: bool,
+    random_init: bool,
+    backend: bool,
+}
+
+impl FileSets {
+    /// What `path` (a `--config` file that already loaded) sets.
+    fn of(path: Option<&Path>) -> Result<FileSets> {
+        let Some(path) = path else {
+            return Ok(FileSets::default());
+        };
+        let keys = psa_experiment::RunConfig::keys_set_by(path)?;
+        let sets = |key: &str| keys.iter().any(|k| k == key);
+        Ok(FileSets {
+            input_sd: sets("problem.noise.input_sd"),
+            output_sd: sets("problem.noise.output_sd"),
+            trials: sets("problem.trials"),
+            random_init: sets("problem.random_init"),
+            backend: sets("problem.backend"),
+        })
     }
-    let model = model(&args, &file)?;
-    let settings = PsaSettings {
-        backend: args.backend,
-        trials: args.trials as usize,
-        random_init: args.random_init,
+}
+
+/// The settings a replay flies: the model, then for noise, trials, random
+/// starts and backend the option where given, else the `--config` file's
+/// value where it sets one, else replay's own default (no noise, one trial
+/// from the paper's start, on `ode`).
+fn flown(args: &ReplayArgs, model: PsaSettings, sets: &FileSets) -> Result<PsaSettings> {
+    let pick = |option: Option<f64>, file_sets: bool, from_file: f64| {
+        option.unwrap_or(if file_sets { from_file } else { 0.0 })
+    };
+    let input_sd = pick(args.input_noise, sets.input_sd, model.noise.input_sd);
+    let output_sd = pick(args.output_noise, sets.output_sd, model.noise.output_sd);
+    check_as("noise.input_sd", "--input-noise", input_sd).map_err(anyhow::Error::msg)?;
+    check_as("noise.output_sd", "--output-noise", output_sd).map_err(anyhow::Error::msg)?;
+    let trials = match args.trials {
+        Some(n) => n as usize,
+        None if sets.trials => model.trials,
+        None => 1,
+    };
+    Ok(PsaSettings {
+        backend: args
+            .backend
+            .unwrap_or(if sets.backend { model.backend } else { BackendKind::Ode }),
+        trials,
+        random_init: args.random_init || (sets.random_init && model.random_init),
         noise: NoiseSettings {
-            input_sd: args.input_noise,
-            output_sd: args.output_noise,
+            input_sd,
+            output_sd,
             ..model.noise
         },
         ..model
-    };
+    })
+}
+
+/// Runs `replay`.
+pub fn run(args: ReplayArgs) -> Result<i32> {
+    for (option, key, value) in [
+        ("--input-noise", "noise.input_sd", args.input_noise),
+        ("--output-noise", "noise.output_sd", args.output_noise),
+    ] {
+        if let Some(value) = value {
+            check_as(key, option, value).map_err(anyhow::Error::msg)?;
+        }
+    }
+    let (file, network) = NetworkFile::load(&args.network)?;
+    let task = args.task.unwrap_or(file.task);
+    let model = model(&args, &file)?;
+    let settings = flown(&args, model, &FileSets::of(args.config.as_deref())?)?;
+    if settings.random_init && !task.has_random_init() {
+        let source = if args.random_init {
+            "--random-init"
+        } else {
+            "the --config file's problem.random_init"
+        };
+        bail!("{source}: task {task} has no random-initialisation variant (tasks 1 and 3 have)");
+    }
     let mut runner = TrialRunner::new(&settings, task)?;
     let mut rng = esp_neuroevolution::rng::stream(args.seed, &[REPLAY_STREAM]);
     let maximum = runner.maximum_points();
@@ -171,7 +240,7 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
         args.network
             .file_name()
             .map_or("network".into(), |s| s.to_string_lossy()),
-        args.backend,
+        settings.backend,
         per_trial[0]
     );
     let files = write_outputs(&out, &first, &settings, title)?;
@@ -179,12 +248,12 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
         let summary = ReplaySummary {
             network: args.network,
             task,
-            backend: args.backend,
-            trials: args.trials,
+            backend: settings.backend,
+            trials: settings.trials as u64,
             seed: args.seed,
-            input_noise: args.input_noise,
-            output_noise: args.output_noise,
-            random_init: args.random_init,
+            input_noise: settings.noise.input_sd,
+            output_noise: settings.noise.output_sd,
+            random_init: settings.random_init,
             fitness_percent_mean: mean,
             fitness_percent_sd: sd,
             fitness_percent_per_trial: per_trial,
@@ -194,8 +263,8 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
     } else {
         say!(
             "task {task}, {} backend, {} trial(s): fitness {mean:.2} % (sd {sd:.2}) of the theoretical maximum",
-            args.backend,
-            args.trials
+            settings.backend,
+            settings.trials
         );
         for f in &files {
             say!("wrote {}", f.display());

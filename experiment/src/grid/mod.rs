@@ -632,7 +632,7 @@ fn set_leaf(table: &mut toml::Table, key: &str, value: toml::Value) {
 }
 
 /// Every leaf setting of a TOML table, as dotted keys with their values.
-fn leaves(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
+pub(crate) fn leaves(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)>) {
     for (key, value) in table {
         let path = format!("{prefix}{key}");
         match value {
@@ -643,16 +643,27 @@ fn leaves(table: &toml::Table, prefix: &str, out: &mut Vec<(String, toml::Value)
 }
 
 /// Every setting of `config` a run of `task` reads
-/// ([`Task::reads_setting`]), one `key = value` line each: two
-/// configurations with the same lines make the same runs of `task`.
+/// ([`Task::reads_setting`]) and its algorithm reads (ESP no
+/// `hill_climb.*` setting, the hill-climber no `esp.*` one), one `key =
+/// value` line each: two configurations with the same lines make the same
+/// runs of `task`.
 pub fn settings_read_by(task: Task, config: &RunConfig) -> Result<String> {
     let mut all = Vec::new();
     leaves(&toml::Table::try_from(config)?, "", &mut all);
     Ok(all
         .into_iter()
-        .filter(|(key, _)| task.reads_setting(key))
+        .filter(|(key, _)| task.reads_setting(key) && algorithm_reads(config.algorithm, key))
         .map(|(key, value)| format!("{key} = {value}\n"))
         .collect())
+}
+
+/// Whether a run of `algorithm` reads the dotted `key`: ESP reads no
+/// `hill_climb.*` setting and the hill-climber no `esp.*` one.
+fn algorithm_reads(algorithm: crate::Algorithm, key: &str) -> bool {
+    match algorithm {
+        crate::Algorithm::Esp => !key.starts_with("hill_climb."),
+        crate::Algorithm::HillClimb => !key.starts_with("esp."),
+    }
 }
 
 /// The value of the dotted `key` in `config` (`None` when absent).

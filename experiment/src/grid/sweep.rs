@@ -270,12 +270,28 @@ impl SweepSpec {
                 .with_context(|| format!("variant {}", variant.name))?;
             let identity = grid_identity(&grid)?;
             if self.mode == SweepMode::OneAtATime {
+                let configs = run_configs(&grid)?;
                 if variant.settings.is_empty() {
-                    base = Some(identity);
+                    base = Some((identity, configs));
                     continue;
                 }
-                if base.as_ref() == Some(&identity) {
-                    continue;
+                if let Some((base_identity, base_configs)) = &base {
+                    if *base_identity == identity {
+                        // The base's own value, named: a row of its own.
+                        if *base_configs == configs {
+                            continue;
+                        }
+                        bail!(
+                            "variant {} runs the same runs as the base: {} changes nothing in this grid's configurations (no task or algorithm of it reads it)",
+                            variant.name,
+                            variant
+                                .settings
+                                .iter()
+                                .map(|(k, v)| format!("{k} = {v}"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        );
+                    }
                 }
             }
             if let Some(other) = seen.get(&identity) {
@@ -441,6 +457,16 @@ fn grid_identity(grid: &GridSpec) -> Result<String> {
         }
     }
     Ok(identity)
+}
+
+/// Every configuration a grid runs, whole, in one string: two grids with
+/// the same string set every setting alike.
+fn run_configs(grid: &GridSpec) -> Result<String> {
+    let mut all = String::new();
+    for &config in &grid.configs {
+        all.push_str(&serde_json::to_string(&grid.run_config(config)?)?);
+    }
+    Ok(all)
 }
 
 /// Sets one of [`GRID_KEYS`] on the grid itself.
