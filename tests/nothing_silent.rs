@@ -1044,22 +1044,55 @@ fn a_task_1_run_is_judged_without_the_problem_task2_table() {
 }
 
 #[test]
-fn report_md_lists_every_setting_a_grid_changes_from_the_defaults() {
+fn report_md_lists_every_setting_a_grid_changes_from_the_defaults_that_its_runs_read() {
     let dir = tempfile::tempdir().unwrap();
     let grid = copy_of_grid(dir.path());
     ok(&psa_esp(&["report", grid.to_str().unwrap()]));
     let plain = std::fs::read_to_string(grid.join("report.md")).unwrap();
     assert!(!plain.contains("changed from the defaults"), "{plain}");
-    // Settings the grid's task-1 run does not read, so that it still counts.
-    set_grid_overrides(&grid, "[problem.tasks]\ntask2_spin = 1.0\ntask3_speed = 0.3\n");
+    let readings = plain.lines().find(|l| l.starts_with("| readings |")).unwrap();
+    assert!(
+        readings.contains("task 1:") && !readings.contains("task 2") && !readings.contains("task 3"),
+        "a task-1 grid's readings name task 1 only: {readings}"
+    );
+    // Settings the grid's task-1 run does not read: its runs are the
+    // default grid's, and the label says so by naming nothing.
+    set_grid_overrides(
+        &grid,
+        "[problem.tasks]\ntask2_spin = 1.0\ntask3_speed = 0.3\n[hill_climb]\nalpha = 1.0\n",
+    );
     ok(&psa_esp(&["report", grid.to_str().unwrap()]));
     let md = std::fs::read_to_string(grid.join("report.md")).unwrap();
-    for setting in [
-        "`problem.tasks.task2_spin = 1.0` (default -0.75)",
-        "`problem.tasks.task3_speed = 0.3` (default 0.4)",
+    assert!(!md.contains("changed from the defaults"), "{md}");
+    // A setting task 1 reads is named (its run, flown without it, is then not counted).
+    set_grid_overrides(&grid, "[problem.tasks]\ntask1_spin = 2.0\ntask2_spin = 1.0\n");
+    let o = psa_esp(&["report", grid.to_str().unwrap()]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr(&o));
+    let md = std::fs::read_to_string(grid.join("report.md")).unwrap();
+    assert!(md.contains("`problem.tasks.task1_spin = 2.0` (default 1.0)"), "{md}");
+    assert!(!md.contains("task2_spin"), "{md}");
+}
+
+#[test]
+fn replicate_refuses_a_configuration_setting_no_task_of_its_grid_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("task2.toml");
+    for (toml, key) in [
+        ("[problem.tasks]\ntask2_spin = 1.0\n", "problem.tasks.task2_spin"),
+        ("[problem.task2]\nsteps = 100\n", "problem.task2.steps"),
     ] {
-        assert!(md.contains(setting), "report.md should name {setting}: {md}");
+        std::fs::write(&config, toml).unwrap();
+        let out = dir.path().join("grid");
+        let mut args = tiny_args(&out);
+        args.extend(["--config", Box::leak(config.display().to_string().into_boxed_str())]);
+        refused(&psa_esp(&args), &[key, "changes nothing", "no task of this grid (1)"]);
+        assert!(!out.exists(), "{key}: nothing written");
     }
+    // The setting a task of the grid reads is taken, as is the default's value.
+    std::fs::write(&config, "[problem.tasks]\ntask1_spin = 2.0\ntask2_spin = -0.75\n").unwrap();
+    let mut args = tiny_args(&dir.path().join("ok"));
+    args.extend(["--config", Box::leak(config.display().to_string().into_boxed_str())]);
+    ok(&psa_esp(&args));
 }
 
 #[test]
@@ -1118,6 +1151,21 @@ fn every_damaged_checkpoint_is_refused_by_one_rule() {
 fn a_speedup_floor_over_too_few_networks_to_batch_is_refused() {
     let o = psa_esp(&["bench", "--speedup-floor", "4", "--networks", "1"]);
     refused(&o, &["--networks 1", "nothing to batch"]);
+    // The portable build flies blocks of 8: 8 networks are enough there,
+    // 7 are not (the message gives the level's own width).
+    let portable = [
+        "bench",
+        "--speedup-level",
+        "portable",
+        "--speedup-floor",
+        "0.001",
+        "--rounds",
+        "1",
+    ];
+    let o = psa_esp(&[&portable[..], &["--networks", "7"]].concat());
+    refused(&o, &["--networks 7", "blocks of 8", "portable"]);
+    let o = psa_esp(&[&portable[..], &["--networks", "8"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 #[test]
@@ -1183,6 +1231,45 @@ fn evolve_refuses_a_folder_name_that_is_not_utf8() {
         .unwrap();
     refused(&o, &["not UTF-8"]);
     assert!(!out.exists());
+}
+
+#[test]
+fn every_command_that_writes_a_folder_refuses_a_name_that_is_not_utf8() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let out = dir.path().join(std::ffi::OsStr::from_bytes(b"out-\xff"));
+    let tiny: Vec<String> = tiny_args(&dir.path().join("unused"))
+        .iter()
+        .map(|a| a.to_string())
+        .take_while(|a| a != "--out")
+        .collect();
+    let mut sweep = tiny.clone();
+    sweep[0] = "sweep".into();
+    sweep.extend(["--vary".into(), "esp.stagnation=20,30".into()]);
+    let grid_arg = grid.display().to_string();
+    let truth = dir.path().join("truth.toml");
+    std::fs::write(&truth, "[problem.fitness]\nstate = \"truth\"\n").unwrap();
+    for command in [
+        tiny,
+        sweep,
+        vec![
+            "rescore".into(),
+            grid_arg.clone(),
+            "--config".into(),
+            truth.display().to_string(),
+        ],
+        vec!["traces".into(), grid_arg],
+    ] {
+        let o = Command::new(common::binary())
+            .args(&command)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        refused(&o, &["--out", "not UTF-8"]);
+        assert!(!out.exists(), "{command:?}: nothing written");
+    }
 }
 
 /// Rescores the grid `source` with the settings `toml` into a folder in

@@ -42,17 +42,18 @@ pub fn check(floor: f64, level: Option<SimdLevel>, networks: u64, rounds: u64) -
     if !(floor.is_finite() && floor > 0.0) {
         bail!("--speedup-floor {floor}: expected a positive ratio");
     }
-    // Fewer networks than one block of the batched path leave nothing to
-    // batch: its speed-up could not be told from its padding.
-    let block = psa_sim::psa::batch::LANES as u64;
-    if networks < block {
-        bail!(
-            "--speedup-floor with --networks {networks}: the batched path flies blocks of {block} networks, so fewer leave nothing to batch and its speed-up cannot be measured; give --networks {block} or more"
-        );
-    }
     let level = level.unwrap_or_else(SimdLevel::detect);
     if !level.is_supported() {
         bail!("--speedup-level {}: this CPU does not support it", level.name());
+    }
+    // Fewer networks than one block of the batched path at this level
+    // leave nothing to batch: its speed-up could not be told from its padding.
+    let block = psa_sim::psa::batch::BatchRunner::widest_block(level) as u64;
+    if networks < block {
+        bail!(
+            "--speedup-floor with --networks {networks}: the batched path flies blocks of {block} networks at the {} level, so fewer leave nothing to batch and its speed-up cannot be measured; give --networks {block} or more",
+            level.name()
+        );
     }
     let evaluator = |path| {
         EvaluationPath {

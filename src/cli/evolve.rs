@@ -85,14 +85,7 @@ pub fn run(args: EvolveArgs) -> Result<i32> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("evolve-{}-task{}-seed{}", args.preset, args.task, args.seed)));
-    // `replay` reads a champion by a UTF-8 path: one written elsewhere
-    // could not be replayed.
-    if out.to_str().is_none() {
-        anyhow::bail!(
-            "--out {}: the folder name is not UTF-8, so `replay` could not read the champion written there; choose a UTF-8 name",
-            out.display()
-        );
-    }
+    super::require_utf8_folder("--out", &out)?;
     if out.read_dir().is_ok_and(|mut entries| entries.next().is_some()) {
         anyhow::bail!(
             "output directory {} is not empty: results already written are never overwritten; choose another --out",

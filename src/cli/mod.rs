@@ -166,6 +166,19 @@ pub fn trajectory_csv(
     csv
 }
 
+/// One rule for every output folder (`--out` of every command that writes
+/// a folder): its name must be UTF-8, so that every later command (`replay`
+/// reading a champion, `report` a grid) can name the files written there.
+pub fn require_utf8_folder(option: &str, path: &std::path::Path) -> anyhow::Result<()> {
+    if path.to_str().is_none() {
+        anyhow::bail!(
+            "{option} {}: the folder name is not UTF-8, so later commands (`replay` reading a champion, `report` a grid) could not name the files written there; choose a UTF-8 name",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Writes one line to standard output; a closed pipe ends the process with success.
 pub fn write_stdout(args: std::fmt::Arguments) -> std::io::Result<()> {
     use std::io::Write;

@@ -206,6 +206,15 @@ pub fn run(args: ReplayArgs) -> Result<i32> {
             check_as(key, option, value).map_err(anyhow::Error::msg)?;
         }
     }
+    if let Some(out) = &args.out {
+        super::require_utf8_folder("--out", out)?;
+    }
+    if args.json && args.network.to_str().is_none() {
+        bail!(
+            "{}: --json names the network file, and its name is not UTF-8; rename it",
+            args.network.display()
+        );
+    }
     let (file, network) = NetworkFile::load(&args.network)?;
     let task = args.task.unwrap_or(file.task);
     let model = model(&args, &file)?;

@@ -280,6 +280,7 @@ pub fn run(args: ReplicateArgs) -> Result<i32> {
     let progress = Progress::new(args.grid.quiet, false);
     let options = args.grid.options()?;
     let clock = Instant::now();
+    super::require_utf8_folder("--out", &args.out)?;
     let summary = replicate(&args.out, &spec, &options, &progress);
     progress.bar.finish_and_clear();
     report_gpu_share(&options.eval_path, clock.elapsed().as_secs_f64())?;

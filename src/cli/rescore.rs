@@ -34,6 +34,7 @@ pub struct RescoreArgs {
 
 /// Runs `rescore`.
 pub fn run(args: RescoreArgs) -> Result<i32> {
+    super::require_utf8_folder("--out", &args.out)?;
     let overlay = read_overrides(&args.config)?;
     let source = GridSpec::load(&args.grid)?;
     let spec = rescored_spec(&source, &overlay, args.robustness_trials.map(|t| t as usize))?;

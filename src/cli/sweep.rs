@@ -35,6 +35,7 @@ pub fn run(args: SweepArgs) -> Result<i32> {
     let progress = Progress::new(args.grid.quiet, true);
     let options = args.grid.options()?;
     let clock = std::time::Instant::now();
+    super::require_utf8_folder("--out", &args.out)?;
     let summary = sweep(&args.out, &spec, &options, &progress);
     progress.bar.finish_and_clear();
     report_gpu_share(&options.eval_path, clock.elapsed().as_secs_f64())?;

@@ -26,6 +26,7 @@ pub struct TracesArgs {
 
 /// Runs `traces`: prints the summary table and the files written.
 pub fn run(args: TracesArgs) -> Result<i32> {
+    super::require_utf8_folder("--out", &args.out)?;
     let (markdown, written) = write_summary(&args.dirs, &args.out, args.pool)?;
     say!("{}", markdown.trim_end());
     for path in written {

@@ -254,6 +254,21 @@ impl GridSpec {
                 }
             }
         }
+        // A setting of the grid's own configuration that no task of the
+        // grid reads would label runs it does not change.
+        if let Some(text) = &self.overrides {
+            let base = crate::RunConfig::baseline_with("")?;
+            let with = crate::RunConfig::baseline_with(text).context("the grid's configuration")?;
+            for (key, value, _) in differences(&with, &base)? {
+                if !self.tasks.iter().any(|task| task.reads_setting(&key)) {
+                    let tasks: Vec<String> = self.tasks.iter().map(Task::to_string).collect();
+                    bail!(
+                        "{key} = {value} in the grid's configuration changes nothing: no task of this grid ({}) reads it (a task reads only its own [problem.tasks] keys and [problem.taskN] table); leave it out, or run the task that reads it",
+                        tasks.join(", ")
+                    );
+                }
+            }
+        }
         for &config in &self.configs {
             let run = self.run_config(config)?;
             for &task in &self.tasks {
@@ -276,6 +291,21 @@ impl GridSpec {
             }
         }
         Ok(())
+    }
+
+    /// Whether a run of the grid reads the dotted `key`: some task it runs
+    /// reads it ([`Task::reads_setting`]) under a configuration whose
+    /// algorithm does (ESP no `hill_climb.*` setting, the hill-climber no
+    /// `esp.*` one).
+    pub fn reads_setting(&self, key: &str) -> Result<bool> {
+        for &config in &self.configs {
+            let run = self.run_config(config)?;
+            let reads = |task: &Task| config.applies_to(*task) && task.reads_setting(key);
+            if algorithm_reads(run.algorithm, key) && self.tasks.iter().any(reads) {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     /// Every run of the grid, in a fixed order (configuration, task, seed),
@@ -528,7 +558,7 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
             }
             // And the settings grid.json states.
             for setting in spec.stated_keys(key.config)? {
-                if !key.task.reads_setting(&setting) {
+                if !key.task.reads_setting(&setting) || !algorithm_reads(expected.algorithm, &setting) {
                     continue;
                 }
                 let (there, here) = (leaf(&found, &setting)?, leaf(&expected, &setting)?);
@@ -708,10 +738,12 @@ pub fn differences(a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, 
 /// [`differences`] in the settings a run of `task` reads: a task-1 run
 /// written under another task-2 start is the same run
 /// ([`Task::reads_setting`]), so a grid whose task 2 changed keeps its
-/// task-1 and task-3 runs.
+/// task-1 and task-3 runs; likewise an ESP run under another hill-climber
+/// setting (and the other way round; a change of algorithm is itself a
+/// difference).
 fn differences_read_by(task: Task, a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, String)>> {
     let mut differ = differences(a, b)?;
-    differ.retain(|(setting, _, _)| task.reads_setting(setting));
+    differ.retain(|(setting, _, _)| task.reads_setting(setting) && algorithm_reads(a.algorithm, setting));
     Ok(differ)
 }
 

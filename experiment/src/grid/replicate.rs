@@ -96,14 +96,15 @@ pub fn prepare(dir: &Path, spec: &GridSpec, shard: Shard, judge: Judge) -> Resul
             dir.display()
         );
     }
-    psa_sim::io::create_output_dir(dir)?;
-    let mut json = serde_json::to_string_pretty(spec)?;
-    json.push('\n');
-    // A new grid is checked whole before its first run (a re-scored grid's
-    // definition is its source's, read as written: `Judge::Read`).
+    // A new grid is checked whole before its folder or its first run (a
+    // re-scored grid's definition is its source's, read as written:
+    // `Judge::Read`).
     if !grid_file.exists() && judge == Judge::Resume {
         spec.check_new()?;
     }
+    psa_sim::io::create_output_dir(dir)?;
+    let mut json = serde_json::to_string_pretty(spec)?;
+    json.push('\n');
     if !grid_file.exists() && psa_sim::io::create_new_atomic(&grid_file, json.as_bytes())? {
         // This process wrote grid.json.
     } else {

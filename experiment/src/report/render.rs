@@ -201,10 +201,18 @@ fn grid_section(md: &mut String, report: &Report) {
         let _ = writeln!(md, "| readings | {} |", report.readings.join("; "));
     }
     // Every setting the grid's own overrides (`--config`) change from the
-    // defaults, so that report.md alone tells two such grids apart.
+    // defaults and a run of the grid reads, so that report.md alone tells
+    // two such grids apart, and names nothing its runs do not fly.
     if let Some(text) = &g.overrides {
-        let changed = crate::RunConfig::baseline_with(text)
-            .and_then(|with| crate::grid::differences(&crate::RunConfig::baseline_with("")?, &with));
+        let changed = crate::RunConfig::baseline_with(text).and_then(|with| {
+            let mut read = Vec::new();
+            for differ in crate::grid::differences(&crate::RunConfig::baseline_with("")?, &with)? {
+                if g.reads_setting(&differ.0)? {
+                    read.push(differ);
+                }
+            }
+            Ok(read)
+        });
         let shown: Vec<String> = match changed {
             Ok(differ) => differ
                 .iter()

@@ -209,7 +209,7 @@ fn readings(results: &GridResults) -> Vec<String> {
         },
         None => config.clone(),
     };
-    config.problem.describe_readings(&scoring.problem)
+    config.problem.describe_readings(&scoring.problem, &results.spec.tasks)
 }
 
 impl Report {

@@ -517,6 +517,16 @@ impl BatchRunner {
         }
     }
 
+    /// The widest block `level` flies (the batch is cut into such blocks):
+    /// [`LANES`] networks on AVX-512 and AVX2, [`SMALL_LANES`] on the
+    /// portable build.
+    pub fn widest_block(level: SimdLevel) -> usize {
+        match level {
+            SimdLevel::Avx512 | SimdLevel::Avx2 => LANES,
+            SimdLevel::Portable => SMALL_LANES,
+        }
+    }
+
     /// The fitness of networks `range` of `networks`, in % of the
     /// theoretical maximum, the mean over `settings.trials` trials: exactly
     /// what [`TrialRunner::evaluate`] gives network `range.start + i` with

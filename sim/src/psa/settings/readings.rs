@@ -45,8 +45,8 @@ impl fmt::Display for Tag {
 #[derive(Clone, Copy)]
 pub enum Describe {
     /// Its lines: of the settings a grid evolved with, and those its
-    /// champions are scored with.
-    Lines(fn(&PsaSettings, &PsaSettings) -> Vec<String>),
+    /// champions are scored with, on the tasks the grid runs.
+    Lines(fn(&PsaSettings, &PsaSettings, &[Task]) -> Vec<String>),
     /// Named in the lines of the row with this key.
     With(&'static str),
 }
@@ -102,11 +102,12 @@ fn fitness_name(kind: FitnessKind) -> &'static str {
     }
 }
 
-/// Each task's line: the fitness it evolves on, over how many steps, and
-/// the one its champions are scored on.
-fn describe_tasks(evolved: &PsaSettings, scoring: &PsaSettings) -> Vec<String> {
+/// Each task's line, of the tasks run: the fitness it evolves on, over
+/// how many steps, and the one its champions are scored on.
+fn describe_tasks(evolved: &PsaSettings, scoring: &PsaSettings, tasks: &[Task]) -> Vec<String> {
     Task::VARIANTS
         .iter()
+        .filter(|task| tasks.contains(task))
         .filter_map(|&task| {
             let s = evolved.for_task(task).ok()?;
             let scored = scoring.scoring_for(task).ok()?;
@@ -121,7 +122,7 @@ fn describe_tasks(evolved: &PsaSettings, scoring: &PsaSettings) -> Vec<String> {
 }
 
 /// The heading input's line: what it measures and its range.
-fn describe_heading(evolved: &PsaSettings, _: &PsaSettings) -> Vec<String> {
+fn describe_heading(evolved: &PsaSettings, _: &PsaSettings, _: &[Task]) -> Vec<String> {
     let heading = match evolved.sensors.heading_input {
         HeadingInput::Error => "the heading error",
         HeadingInput::Absolute => "the absolute heading",
@@ -158,7 +159,7 @@ pub const READINGS: &[Reading] = &[
             on: |s| s.fitness.slowing == SlowingRule::Signed,
         }),
         task_key: None,
-        describe: Describe::Lines(|s, _| match s.fitness.slowing {
+        describe: Describe::Lines(|s, _, _| match s.fitness.slowing {
             // Named only where it is not the default, as reports did before it was a row.
             SlowingRule::Magnitude => Vec::new(),
             SlowingRule::Signed => vec!["the spin slows when its signed value falls".into()],
@@ -198,7 +199,7 @@ pub const READINGS: &[Reading] = &[
             on: |s| s.noise.on_bias,
         }),
         task_key: None,
-        describe: Describe::Lines(|s, _| {
+        describe: Describe::Lines(|s, _, _| {
             vec![format!(
                 "input noise on the bias: {}",
                 if s.noise.on_bias { "yes" } else { "no" }
@@ -215,7 +216,7 @@ pub const READINGS: &[Reading] = &[
             on: |s| s.noise.stage == NoiseStage::Raw,
         }),
         task_key: None,
-        describe: Describe::Lines(|s, _| {
+        describe: Describe::Lines(|s, _, _| {
             vec![format!(
                 "input noise: {}",
                 match s.noise.stage {
@@ -235,7 +236,7 @@ pub const READINGS: &[Reading] = &[
             on: |s| s.fitness.state == FitnessState::Sensed,
         }),
         task_key: None,
-        describe: Describe::Lines(|s, _| {
+        describe: Describe::Lines(|s, _, _| {
             vec![format!(
                 "the fitness reads the {} state",
                 match s.fitness.state {
@@ -282,15 +283,15 @@ pub fn every_test_value(mut settings: PsaSettings) -> PsaSettings {
 impl PsaSettings {
     /// The readings of the inputs and the fitness these settings fly, in
     /// words, for reports: the lines of every row of [`READINGS`] in order
-    /// (per task the fitness evolved on, the trial's length and the fitness
+    /// (per task of `tasks` the fitness evolved on, the trial's length and the fitness
     /// champions are scored on under `scoring`, these settings or the ones
     /// a re-scored grid tests with; the heading input; the noise on the
     /// bias; the state the fitness reads).
-    pub fn describe_readings(&self, scoring: &PsaSettings) -> Vec<String> {
+    pub fn describe_readings(&self, scoring: &PsaSettings, tasks: &[Task]) -> Vec<String> {
         READINGS
             .iter()
             .flat_map(|row| match row.describe {
-                Describe::Lines(lines) => lines(self, scoring),
+                Describe::Lines(lines) => lines(self, scoring, tasks),
                 Describe::With(_) => Vec::new(),
             })
             .collect()
@@ -393,8 +394,8 @@ mod tests {
             (row.set_test_value)(&mut s);
             assert_ne!(s, default, "{}", row.key);
             assert_ne!(
-                s.describe_readings(&s),
-                default.describe_readings(&default),
+                s.describe_readings(&s, Task::VARIANTS),
+                default.describe_readings(&default, Task::VARIANTS),
                 "{} does not show in the report's readings",
                 row.key
             );
