@@ -772,7 +772,15 @@ fn a_run_resumed_without_lockstep_leaves_no_checkpoint() {
     let folder = run_folder(&grid);
     let expected = names_in(&folder);
     std::fs::remove_file(folder.join("robustness.json")).unwrap();
-    std::fs::write(folder.join("checkpoint.json"), "{\"not\": \"this run\"}").unwrap();
+    // A saved run that reads (of another search: another seed), as a
+    // lockstep process leaves: the ordinary executor runs the run from its
+    // start and removes it.
+    let saved: esp_neuroevolution::AnyRun = esp_neuroevolution::Esp::new(psa_experiment::paper_esp_settings(), 99)
+        .unwrap()
+        .start(7, 4)
+        .unwrap()
+        .into();
+    std::fs::write(folder.join("checkpoint.json"), serde_json::to_string(&saved).unwrap()).unwrap();
     ok(&psa_esp(&tiny_args(&grid)));
     assert_eq!(names_in(&folder), expected);
 }
@@ -1131,19 +1139,25 @@ fn every_damaged_checkpoint_is_refused_by_one_rule() {
     let folder = run_folder(&grid);
     std::fs::remove_file(folder.join("robustness.json")).unwrap();
     let checkpoint = folder.join("checkpoint.json");
-    let mut args = tiny_args(&grid);
-    args.push("--lockstep");
-    for (what, bytes) in [
-        ("zeroed", vec![0u8; 4096]),
-        ("truncated", b"{\"Esp\":{\"records\":[".to_vec()),
-        ("empty", Vec::new()),
-        ("garbage", vec![0xff, 0xfe, 0x00, 0x41]),
-    ] {
-        std::fs::write(&checkpoint, &bytes).unwrap();
-        let o = run_within(&args, Duration::from_secs(60)).unwrap_or_else(|| panic!("{what}: hangs"));
-        refused(&o, &["checkpoint.json", "remove it to start the run afresh"]);
-        assert!(!folder.join("robustness.json").exists(), "{what}: the run was not run");
-        std::fs::remove_file(&checkpoint).unwrap();
+    let plain = tiny_args(&grid);
+    let mut lockstep = plain.clone();
+    lockstep.push("--lockstep");
+    // The lockstep executor, which resumes from a checkpoint, and the
+    // ordinary one, which runs a run from its start: one rule for both.
+    for args in [&lockstep, &plain] {
+        for (what, bytes) in [
+            ("zeroed", vec![0u8; 4096]),
+            ("truncated", b"{\"Esp\":{\"records\":[".to_vec()),
+            ("empty", Vec::new()),
+            ("garbage", vec![0xff, 0xfe, 0x00, 0x41]),
+        ] {
+            std::fs::write(&checkpoint, &bytes).unwrap();
+            let o = run_within(args, Duration::from_secs(60)).unwrap_or_else(|| panic!("{what}: hangs"));
+            refused(&o, &["checkpoint.json", "remove it to start the run afresh"]);
+            assert!(!folder.join("robustness.json").exists(), "{what}: the run was not run");
+            assert!(checkpoint.exists(), "{what}: the file is left for the user");
+            std::fs::remove_file(&checkpoint).unwrap();
+        }
     }
 }
 

@@ -36,10 +36,26 @@ pub(crate) fn save_checkpoints(runs: &[AnyRun], files: &[PathBuf]) {
 }
 
 /// Refuses a run whose checkpoint is there but not a regular file (a
-/// directory, a FIFO, a link): it could be neither read nor removed.
+/// directory, a FIFO, a link): it could be neither read nor removed; or a
+/// damaged one, by every executor alike (the run is never restarted over a
+/// file that cannot be read: [`resume`]'s rule). A checkpoint that reads is
+/// left to the executor (an executor that does not resume runs the run
+/// from its start, to the same results, and removes it when finished).
 pub(crate) fn check_checkpoint(folder: &Path) -> Result<()> {
     let file = folder.join(CHECKPOINT);
     match std::fs::symlink_metadata(&file) {
+        Ok(meta) if meta.file_type().is_file() => {
+            let json = psa_sim::io::read_input_text(&file).map_err(|problem| {
+                anyhow::anyhow!("{}: {problem}; remove it to start the run afresh", file.display())
+            })?;
+            match serde_json::from_str::<AnyRun>(&json) {
+                Ok(_) => Ok(()),
+                Err(e) => anyhow::bail!(
+                    "{}: damaged, not a saved run ({e}); remove it to start the run afresh",
+                    file.display()
+                ),
+            }
+        }
         Ok(meta) if !meta.file_type().is_file() => anyhow::bail!(
             "{}: it is not a regular file (a {}); remove it to run the run",
             file.display(),

@@ -182,12 +182,17 @@ fn unix_now() -> u64 {
 }
 
 /// The start time of process `pid` in clock ticks after boot (field 22 of
-/// `/proc/PID/stat`), where the system has `/proc`.
+/// `/proc/PID/stat`), where the system has `/proc` and the process runs:
+/// one that has exited (a zombie its parent has not reaped, state `Z`, or
+/// `X`) has none.
 fn process_start(pid: u32) -> Option<u64> {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
     // The command name (field 2) is in parentheses and may hold spaces.
-    let after_name = &stat[stat.rfind(')')? + 1..];
-    after_name.split_whitespace().nth(19)?.parse().ok()
+    let mut fields = stat[stat.rfind(')')? + 1..].split_whitespace();
+    if matches!(fields.next()?, "Z" | "X") {
+        return None;
+    }
+    fields.nth(18)?.parse().ok()
 }
 
 /// Whether process `pid` of this host still runs and is the one that
@@ -215,6 +220,23 @@ mod tests {
             started: "2026-01-01T00:00:00Z".into(),
             started_unix: unix_now() - age,
         }
+    }
+
+    #[test]
+    fn a_claimant_that_has_exited_but_is_not_reaped_is_dead() {
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let pid = child.id();
+        // Until reaped, the exited child is a zombie: /proc still lists it.
+        let zombie = (0..500).any(|_| {
+            std::thread::sleep(std::time::Duration::from_millis(10));
+            std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|s| s.contains(") Z "))
+        });
+        assert!(zombie, "the child never showed as a zombie");
+        assert!(!process_alive(pid, None));
+        child.wait().unwrap();
+        // A running process is alive, and its start time is read.
+        let me = std::process::id();
+        assert!(process_alive(me, process_start(me)));
     }
 
     #[test]
