@@ -324,6 +324,14 @@ fn a_run_is_judged_on_the_settings_its_task_reads_only() {
         "{err}"
     );
     assert!(!err.contains(task1.to_str().unwrap()), "{err}");
+    // No build ever started task 2 at 0.3 rad/s: a run of another grid,
+    // which `report` refuses too, and the refusal says so.
+    assert!(
+        err.contains("another grid") && err.contains("does not count either") && !err.contains("`report` reads it"),
+        "{err}"
+    );
+    let o = psa_esp(&["report", dir.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("task2/seed1"));
     assert!(results(&dir) == before, "a run folder was overwritten");
     // Without the task-2 run, the grid resumes it and keeps task 1's.
     std::fs::remove_dir_all(&task2).unwrap();

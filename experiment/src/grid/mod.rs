@@ -493,8 +493,15 @@ pub fn judge_run(dir: &Path, spec: &GridSpec, key: &RunKey, judge: Judge) -> Res
                     .iter()
                     .map(|(setting, there, here)| format!("{setting} = {there} there, {here} in this build"))
                     .collect();
+                // Only a run of this grid under its build's defaults is
+                // one `report` reads; say which this is.
+                let why = if judge_run(dir, spec, key, Judge::Read).is_ok() {
+                    "a run of this grid under an earlier build's defaults: `report` reads it, and resuming needs the build that wrote it, or another output directory"
+                } else {
+                    "a run of another grid, which `report` does not count either: move it away, or use another output directory"
+                };
                 bail!(
-                    "{}: holds a different configuration than {} in this grid ({}): {}; a run of another grid, or of this grid under an earlier build's defaults: `report` reads it, and resuming needs the build that wrote it, or another output directory",
+                    "{}: holds a different configuration than {} in this grid ({}): {}; {why}",
                     folder.display(),
                     key.config,
                     folder_build(&folder),
