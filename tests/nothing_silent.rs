@@ -557,7 +557,11 @@ fn a_rescoring_setting_that_changes_no_test_is_refused_naming_it() {
 /// `changed`: its config.toml without the table's keys, its run.json
 /// naming that build.
 fn age_run(grid: &Path, changed: &str) {
-    let folder = run_folder(grid);
+    age_run_folder(&run_folder(grid), changed);
+}
+
+/// [`age_run`] for the run in `folder`.
+fn age_run_folder(folder: &Path, changed: &str) {
     let text = std::fs::read_to_string(folder.join("config.toml")).unwrap();
     let mut table: toml::Table = toml::from_str(&text).unwrap();
     for row in CHANGES {
@@ -578,6 +582,34 @@ fn age_run(grid: &Path, changed: &str) {
     build.remove("defaults");
     build.insert("git_commit".into(), parent_of(changed).into());
     std::fs::write(&path, serde_json::to_string_pretty(&run).unwrap()).unwrap();
+}
+
+#[test]
+fn a_report_says_above_its_tables_when_its_runs_flew_different_models() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = dir.path().join("grid");
+    let mut args = tiny_args(&grid);
+    let at = args.iter().position(|a| *a == "--seeds").unwrap();
+    args[at + 1] = "2";
+    ok(&psa_esp(&args));
+    // Seed 2 as a build before the positive heading wrap wrote it: counted
+    // (this grid under its build's defaults), but another model.
+    age_run_folder(&grid.join("runs/baseline/task1/seed2"), "a70d696");
+    let o = psa_esp(&["report", grid.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("mixed models"), "{}", stderr(&o));
+    let md = std::fs::read_to_string(grid.join("report.md")).unwrap();
+    let banner = md.lines().find(|l| l.starts_with("**MIXED MODELS")).expect("a banner");
+    assert!(
+        banner.contains("baseline task 1: `problem.sensors.position_scale` = 10.0 in 1, 5.0 in 1"),
+        "{banner}"
+    );
+    assert!(md.find("**MIXED MODELS").unwrap() < md.find("## Grid").unwrap());
+    // One model: no banner.
+    std::fs::remove_dir_all(grid.join("runs/baseline/task1/seed2")).unwrap();
+    ok(&psa_esp(&args));
+    let o = psa_esp(&["report", grid.to_str().unwrap()]);
+    assert!(!stderr(&o).contains("mixed models"));
 }
 
 #[test]

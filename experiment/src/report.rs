@@ -225,6 +225,8 @@ pub struct ReportOutcome {
     pub problems: Vec<String>,
     /// Figures that could not be drawn (e.g. no font installed).
     pub figure_problems: Vec<String>,
+    /// Where counted runs flew different models ([`Report::mixed_models`]).
+    pub mixed_models: Vec<String>,
 }
 
 impl ReportOutcome {
@@ -300,5 +302,6 @@ pub fn write_report_against(dir: &Path, format: ReportFormat, against: Option<&P
         expected: results.spec.runs().len(),
         problems: report.problems.iter().map(|p| p.message.clone()).collect(),
         figure_problems,
+        mixed_models: report.mixed_models.clone(),
     })
 }

@@ -76,6 +76,9 @@ pub fn run(args: ReportArgs) -> Result<i32> {
             ""
         }
     );
+    for mixed in &outcome.mixed_models {
+        eprintln!("warning: mixed models, averaged together: {mixed} (see report.md)");
+    }
     for problem in &outcome.figure_problems {
         eprintln!("warning: figure not drawn: {problem}");
     }

@@ -704,7 +704,7 @@ fn algorithm_reads(algorithm: crate::Algorithm, key: &str) -> bool {
 }
 
 /// The value of the dotted `key` in `config` (`None` when absent).
-fn leaf(config: &RunConfig, key: &str) -> Result<Option<toml::Value>> {
+pub(crate) fn leaf(config: &RunConfig, key: &str) -> Result<Option<toml::Value>> {
     let table = toml::Table::try_from(config)?;
     let mut at = &table;
     let mut parts: Vec<&str> = key.split('.').collect();
@@ -748,7 +748,7 @@ pub fn differences(a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, 
 /// task-1 and task-3 runs; likewise an ESP run under another hill-climber
 /// setting (and the other way round; a change of algorithm is itself a
 /// difference).
-fn differences_read_by(task: Task, a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, String)>> {
+pub(crate) fn differences_read_by(task: Task, a: &RunConfig, b: &RunConfig) -> Result<Vec<(String, String, String)>> {
     let mut differ = differences(a, b)?;
     differ.retain(|(setting, _, _)| task.reads_setting(setting) && algorithm_reads(a.algorithm, setting));
     Ok(differ)

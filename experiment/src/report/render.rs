@@ -164,6 +164,14 @@ fn banners(md: &mut String, report: &Report) {
             report.problems.len()
         );
     }
+    if !report.mixed_models.is_empty() {
+        let _ = writeln!(
+            md,
+            "**MIXED MODELS: runs of one configuration and task flew different models (written by builds with other defaults); \
+             every number below averages them: {}.**\n",
+            report.mixed_models.join("; ")
+        );
+    }
 }
 
 fn grid_section(md: &mut String, report: &Report) {

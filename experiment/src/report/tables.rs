@@ -123,6 +123,11 @@ pub struct Report {
     /// first counted run's own configuration (a grid of an earlier build
     /// flew its build's defaults); empty without a counted run.
     pub readings: Vec<String>,
+    /// Where counted runs of one configuration and task flew different
+    /// models (a setting their task reads differs: runs written by builds
+    /// with other defaults), one line per such setting with how many runs
+    /// flew each value; empty when every cell flew one model.
+    pub mixed_models: Vec<String>,
     /// Wall-clock seconds of the counted runs, added up.
     pub compute_seconds: f64,
     /// Runs of the grid.
@@ -212,6 +217,48 @@ fn readings(results: &GridResults) -> Vec<String> {
     config.problem.describe_readings(&scoring.problem, &results.spec.tasks)
 }
 
+/// [`Report::mixed_models`]: for each configuration and task, every
+/// setting its task reads in which its counted runs (each by its own
+/// files, [`crate::grid::run_folder_config`]) differ, and how many flew
+/// each value.
+fn mixed_models(results: &GridResults) -> Vec<String> {
+    let mut cells: BTreeMap<(String, String), (Task, Vec<crate::RunConfig>)> = BTreeMap::new();
+    for run in &results.runs {
+        let folder = crate::grid::run_dir(&results.dir, &run.key);
+        if let Ok(config) = crate::grid::run_folder_config(&folder) {
+            cells
+                .entry((run.key.config.name().to_string(), run.key.task.to_string()))
+                .or_insert_with(|| (run.key.task, Vec::new()))
+                .1
+                .push(config);
+        }
+    }
+    let mut lines = Vec::new();
+    for ((config, _), (task, runs)) in cells {
+        let mut keys: Vec<String> = Vec::new();
+        for run in &runs[1..] {
+            for (key, _, _) in crate::grid::differences_read_by(task, run, &runs[0]).unwrap_or_default() {
+                if !keys.contains(&key) {
+                    keys.push(key);
+                }
+            }
+        }
+        for key in keys {
+            let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+            for run in &runs {
+                let value = crate::grid::leaf(run, &key)
+                    .ok()
+                    .flatten()
+                    .map_or("nothing".to_string(), |v| v.to_string());
+                *counts.entry(value).or_default() += 1;
+            }
+            let shown: Vec<String> = counts.iter().map(|(v, n)| format!("{v} in {n}")).collect();
+            lines.push(format!("{config} task {task}: `{key}` = {}", shown.join(", ")));
+        }
+    }
+    lines
+}
+
 impl Report {
     /// The report of `results` (figures not yet drawn).
     pub fn from_results(results: &GridResults) -> Report {
@@ -233,6 +280,7 @@ impl Report {
             reduced: reductions(spec),
             builds: builds(results),
             readings: readings(results),
+            mixed_models: mixed_models(results),
             compute_seconds: results.runs.iter().map(|r| r.summary.seconds).sum(),
             runs_expected: spec.runs().len(),
             runs_counted: results.runs.len(),
