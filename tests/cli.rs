@@ -58,6 +58,14 @@ fn simulate_writes_the_trajectory_csv() {
             (last[0] - 2.0).abs() < 1e-12 && last[1] > 0.0 && last[2] == 0.0 && last[6] == 0.0,
             "{last:?}"
         );
+        // The size was said before anything was written, and it bounds the file's rows.
+        let said = stderr(&o);
+        assert!(
+            said.starts_with("simulate: 41 states, at most 5.7 kB of trajectory to "),
+            "{said}"
+        );
+        let rows: usize = lines[1..].iter().map(|l| l.len() + 1).sum();
+        assert!(rows <= 41 * 140, "{rows}");
     }
 }
 

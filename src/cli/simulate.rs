@@ -52,7 +52,22 @@ pub struct SimulateArgs {
 /// The default number of steps of a trial (`[chosen]` 500 x 0.05 s = 25 s).
 const DEFAULT_STEPS: u64 = 500;
 
-/// The most steps of one simulation: about 100 GB of CSV and an hour or two
+/// The most bytes a trajectory row takes: seven numbers of at most 19
+/// characters each (a float's shortest round trip, sign and exponent
+/// included) and their separators.
+const MAX_BYTES_PER_STATE: u64 = 7 * 19 + 7;
+
+/// `bytes` in kB, MB or GB (decimal, one decimal place).
+fn size_label(bytes: u64) -> String {
+    let b = bytes as f64;
+    match bytes {
+        0..=999_999 => format!("{:.1} kB", b / 1e3),
+        1_000_000..=999_999_999 => format!("{:.1} MB", b / 1e6),
+        _ => format!("{:.1} GB", b / 1e9),
+    }
+}
+
+/// The most steps of one simulation: at most 140 GB of CSV and an hour or two
 /// of ODE; the trajectory is streamed, so only time and disk grow with it.
 pub const MAX_STEPS: u64 = 1_000_000_000;
 
@@ -178,6 +193,20 @@ pub fn run(args: SimulateArgs) -> Result<i32> {
     let start = start_state(&args.start)?;
     let commands = commands(&args)?;
     let mut backend = create_backend(args.backend, &model, &settings)?;
+    // The output grows with the steps (up to about 140 GB at MAX_STEPS):
+    // its size is said before the first state is written, once the file
+    // can be written.
+    if let Some(path) = &args.out {
+        psa_sim::io::check_output_file(path)?;
+    }
+    let states = commands.steps + 1;
+    eprintln!(
+        "simulate: {states} states, at most {} of trajectory to {}",
+        size_label(states * MAX_BYTES_PER_STATE),
+        args.out
+            .as_ref()
+            .map_or("standard output".to_string(), |p| p.display().to_string())
+    );
     match &args.out {
         Some(path) => {
             let mut written = 0;
