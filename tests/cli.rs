@@ -234,11 +234,16 @@ fn spin_damper() -> esp_neuroevolution::network::Network {
     .unwrap()
 }
 
-#[test]
-fn replay_flies_the_config_files_noise_trials_and_starts_and_an_option_wins_over_the_file() {
+/// The spin damper's network file in `dir` (`damper.json`).
+///
+/// The damper is made for task 1's earlier start spin of 1 rad/s (at the
+/// default 2 rad/s its full thrust pushes the PSA out of the box before
+/// the spin stops) and for a spin input of 1 per rad/s (its weights of
+/// 20 saturate the braking neurons; the default scale halves them); the
+/// file records that model, and replay flies on it.
+fn damper_file(dir: &std::path::Path) -> std::path::PathBuf {
     use psa_sim::psa::{NetworkFile, PsaSettings, Task};
-    let dir = tempfile::tempdir().unwrap();
-    let net_path = dir.path().join("damper.json");
+    let net_path = dir.join("damper.json");
     let mut model = PsaSettings::default();
     model.tasks.task1_spin = 1.0;
     model.sensors.angular_velocity_scale = 1.0;
@@ -251,6 +256,13 @@ fn replay_flies_the_config_files_noise_trials_and_starts_and_an_option_wins_over
     )
     .save(&net_path)
     .unwrap();
+    net_path
+}
+
+#[test]
+fn replay_flies_the_config_files_noise_trials_and_starts_and_an_option_wins_over_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let net_path = damper_file(dir.path());
     let config = dir.path().join("noisy.toml");
     std::fs::write(
         &config,
@@ -318,26 +330,8 @@ fn replay_flies_the_config_files_noise_trials_and_starts_and_an_option_wins_over
 
 #[test]
 fn replay_prints_the_fitness_and_writes_trajectory_pictures_and_animation() {
-    use psa_sim::psa::{NetworkFile, PsaSettings, Task};
     let dir = tempfile::tempdir().unwrap();
-    let net_path = dir.path().join("damper.json");
-    // The damper is made for task 1's earlier start spin of 1 rad/s (at the
-    // default 2 rad/s its full thrust pushes the PSA out of the box before
-    // the spin stops) and for a spin input of 1 per rad/s (its weights of
-    // 20 saturate the braking neurons; the default scale halves them); the
-    // file records that model, and replay flies on it.
-    let mut model = PsaSettings::default();
-    model.tasks.task1_spin = 1.0;
-    model.sensors.angular_velocity_scale = 1.0;
-    NetworkFile::new(
-        &spin_damper(),
-        Task::StopRotation,
-        &model,
-        &psa_experiment::build_info(),
-        serde_json::Map::new(),
-    )
-    .save(&net_path)
-    .unwrap();
+    let net_path = damper_file(dir.path());
     let out = dir.path().join("replay");
     let o = psa_esp(&[
         "replay",
