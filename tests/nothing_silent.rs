@@ -753,6 +753,53 @@ fn a_checkpoint_that_is_not_a_bounded_regular_file_is_refused_before_the_run() {
     refused(&psa_esp(&tiny_args(&grid)), &["checkpoint.json"]);
 }
 
+#[test]
+fn a_run_claimed_by_a_process_that_has_exited_but_is_not_reaped_is_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = copy_of_grid(dir.path());
+    let folder = run_folder(&grid);
+    std::fs::remove_file(folder.join("robustness.json")).unwrap();
+    // A claimant that has exited and that its parent (this test) has not
+    // reaped: /proc still lists it, as a zombie.
+    let mut child = Command::new("true").spawn().unwrap();
+    let pid = child.id();
+    let stat = (0..500)
+        .find_map(|_| {
+            std::thread::sleep(Duration::from_millis(10));
+            std::fs::read_to_string(format!("/proc/{pid}/stat"))
+                .ok()
+                .filter(|s| s.contains(") Z "))
+        })
+        .expect("the child shows as a zombie");
+    let start: u64 = stat[stat.rfind(')').unwrap() + 1..]
+        .split_whitespace()
+        .nth(19)
+        .unwrap()
+        .parse()
+        .unwrap();
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_secs();
+    let claim = serde_json::json!({
+        "host": psa_sim::provenance::host_name(),
+        "pid": pid,
+        "process_start": start,
+        "started": "2026-12-02T00:00:00Z",
+        "started_unix": now,
+    });
+    std::fs::write(folder.join("claim.json"), claim.to_string()).unwrap();
+    let o = psa_esp(&tiny_args(&grid));
+    child.wait().unwrap();
+    ok(&o);
+    assert!(
+        folder.join("robustness.json").exists(),
+        "the run was run: {}",
+        stderr(&o)
+    );
+    assert!(!stderr(&o).contains("left to another process"), "{}", stderr(&o));
+}
+
 // 8. A finished grid holds only its documented files.
 
 #[test]
