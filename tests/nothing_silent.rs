@@ -601,7 +601,7 @@ fn a_report_says_above_its_tables_when_its_runs_flew_different_models() {
     let md = std::fs::read_to_string(grid.join("report.md")).unwrap();
     let banner = md.lines().find(|l| l.starts_with("**MIXED MODELS")).expect("a banner");
     assert!(
-        banner.contains("baseline task 1: `problem.sensors.position_scale` = 10.0 in 1, 5.0 in 1"),
+        banner.contains("baseline task 1: `problem.sensors.position_scale` = 10.0 in 1 (seeds 2), 5.0 in 1 (seeds 1)"),
         "{banner}"
     );
     assert!(md.find("**MIXED MODELS").unwrap() < md.find("## Grid").unwrap());

@@ -222,7 +222,8 @@ fn readings(results: &GridResults) -> Vec<String> {
 /// files, [`crate::grid::run_folder_config`]) differ, and how many flew
 /// each value.
 fn mixed_models(results: &GridResults) -> Vec<String> {
-    let mut cells: BTreeMap<(String, String), (Task, Vec<crate::RunConfig>)> = BTreeMap::new();
+    type Cell = (Task, Vec<(u64, crate::RunConfig)>);
+    let mut cells: BTreeMap<(String, String), Cell> = BTreeMap::new();
     for run in &results.runs {
         let folder = crate::grid::run_dir(&results.dir, &run.key);
         if let Ok(config) = crate::grid::run_folder_config(&folder) {
@@ -230,29 +231,33 @@ fn mixed_models(results: &GridResults) -> Vec<String> {
                 .entry((run.key.config.name().to_string(), run.key.task.to_string()))
                 .or_insert_with(|| (run.key.task, Vec::new()))
                 .1
-                .push(config);
+                .push((run.key.seed, config));
         }
     }
     let mut lines = Vec::new();
     for ((config, _), (task, runs)) in cells {
         let mut keys: Vec<String> = Vec::new();
-        for run in &runs[1..] {
-            for (key, _, _) in crate::grid::differences_read_by(task, run, &runs[0]).unwrap_or_default() {
+        for (_, run) in &runs[1..] {
+            for (key, _, _) in crate::grid::differences_read_by(task, run, &runs[0].1).unwrap_or_default() {
                 if !keys.contains(&key) {
                     keys.push(key);
                 }
             }
         }
         for key in keys {
-            let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-            for run in &runs {
+            // Each value with the seeds of the runs that flew it.
+            let mut seeds: BTreeMap<String, Vec<String>> = BTreeMap::new();
+            for (seed, run) in &runs {
                 let value = crate::grid::leaf(run, &key)
                     .ok()
                     .flatten()
                     .map_or("nothing".to_string(), |v| v.to_string());
-                *counts.entry(value).or_default() += 1;
+                seeds.entry(value).or_default().push(seed.to_string());
             }
-            let shown: Vec<String> = counts.iter().map(|(v, n)| format!("{v} in {n}")).collect();
+            let shown: Vec<String> = seeds
+                .iter()
+                .map(|(v, s)| format!("{v} in {} (seeds {})", s.len(), s.join(" ")))
+                .collect();
             lines.push(format!("{config} task {task}: `{key}` = {}", shown.join(", ")));
         }
     }
