@@ -1,4 +1,4 @@
-//! Hostile input never kills, hangs or exhausts the tool (issue 28): every
+//! Hostile input never kills, hangs or exhausts the tool: every
 //! row runs the built binary on input a careless user or an attacker might
 //! give and expects exit code 2 and a message naming the offending key or
 //! argument, within a time limit (a hang is killed and fails the test) and

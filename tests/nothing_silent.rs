@@ -1,4 +1,4 @@
-//! Nothing silent (issue 53): every setting a command takes either acts
+//! Nothing silent: every setting a command takes either acts
 //! or is refused, old results stay readable, and no output path can
 //! clobber the system. One test (or a few) per defect of the issue, each
 //! named after what it holds.
@@ -990,7 +990,7 @@ fn docs_limits_states_the_rules_for_output_paths_and_checkpoints() {
     assert!(doc.contains(&quoted), "docs/limits.md should quote {quoted:?}");
 }
 
-// Round two (issue 66): a run is judged on the settings its own task
+// A run is judged on the settings its own task
 // reads (`Task::reads_setting`), in every command.
 
 /// A finished tiny grid of task 2 alone in `dir/name`.
@@ -1385,7 +1385,7 @@ fn rescore_is_refused_as_changing_nothing(dir: &Path, source: &Path, toml: &str,
     assert!(!out.exists(), "{key}: nothing written");
 }
 
-// Round three (issue 74): the trace tools, `evolve --trace` and `traces`.
+// The trace tools, `evolve --trace` and `traces`.
 
 /// The CSV header of a trace.
 const TRACE_COLUMNS: &str = "generation,max,champion,subpops,burst,topology,top_first_pass,top_entries,\

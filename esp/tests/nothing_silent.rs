@@ -1,4 +1,4 @@
-//! Nothing silent in the search crate (issue 53): a clone of a run is a
+//! Nothing silent in the search crate: a clone of a run is a
 //! run of its own, a search read from JSON is checked as one built in
 //! code, and the seed is written where JSON tools keep every digit.
 

@@ -83,7 +83,7 @@ impl OdeBackend {
         )?)
     }
 
-    /// Times our ODE path against the bare ODE calls it makes (issue 6: our
+    /// Times our ODE path against the bare ODE calls it makes (our
     /// overhead must stay <= 10 %). Returns the (ours, bare) time of
     /// `steps` steps, each the minimum over `rounds` rounds (the least
     /// disturbed run on a noisy machine).
@@ -149,7 +149,7 @@ impl PhysicsBackend for OdeBackend {
         planar_state(&self.body)
     }
 
-    /// The hot path (issue 6): no allocation, and no check beyond
+    /// The hot path: no allocation, and no check beyond
     /// `validate_thrust` and the [`StepGuard`]. Their guarantees (one finite
     /// value in [0, 1] per thruster; a state from which this step stays
     /// finite, far from overflowing ODE's quaternion update) and those of
