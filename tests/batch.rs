@@ -13,6 +13,7 @@ use kernel_cases::{
 };
 use psa_sim::evaluator::{trial_scores, EvalPath};
 use psa_sim::numeric::{Exponential, SimdLevel};
+use psa_sim::physics::BackendKind;
 use psa_sim::psa::batch::{LANES, NARROW_LANES, SMALL_LANES};
 use psa_sim::psa::cuda::{evaluate_with, fly_on_host};
 use psa_sim::psa::{BatchRunner, PsaSettings, Task, TrialRunner};
@@ -205,15 +206,18 @@ fn a_networks_trials_flown_side_by_side_are_the_scalar_trials_bit_for_bit_on_eve
     // The robustness tests' many trials of one champion, one trial per
     // lane: every width (a padded small block alone, small and narrow
     // remainders, full wide blocks), with noise and random starts and
-    // without, on every SIMD level and through every evaluation path.
+    // without, on every SIMD level and through every evaluation path of
+    // native (each of `EvalPath::all_readable` but the ODE paths).
     let clean = native(PsaSettings::default());
     let cases = [
         (clean.clone(), Task::Turn),
         (noisy_settings(), Task::StopAtPosition),
         (original_fitness_settings(), Task::StopRotation),
     ];
-    let mut paths: Vec<EvalPath> = SimdLevel::VARIANTS.iter().copied().map(EvalPath::Simd).collect();
-    paths.extend([EvalPath::Fastest, EvalPath::Scalar, EvalPath::KernelOnHost]);
+    let paths: Vec<EvalPath> = EvalPath::all_readable()
+        .into_iter()
+        .filter(|path| path.backend() != Some(BackendKind::Ode))
+        .collect();
     for (settings, task) in cases {
         for trials in [1, SMALL_LANES + 1, NARROW_LANES + 3, 2 * LANES + 5] {
             let settings = PsaSettings {

@@ -282,46 +282,109 @@ fn a_network_file_from_before_a_setting_loads_with_the_value_its_build_used() {
     assert_eq!(load_json(dir.path(), &new).unwrap(), PsaSettings::default());
 }
 
-/// The earlier models of `configs/` and the commit whose builds had them
-/// as defaults: the parent of the commit that changed them.
-const MODELS: [(&str, &str); 4] = [
-    ("configs/previous-defaults.toml", "95ee59b"),
-    ("configs/fitted-incremental.toml", "d497677"),
-    ("configs/scored-on-original.toml", "a1ccaad"),
-    ("configs/symmetric-heading.toml", "a70d696"),
+/// Where an earlier model stands in the table of defaults.
+enum Build {
+    /// The defaults of the builds before this commit (its parent's).
+    Before(&'static str),
+    /// The defaults of the builds before the table's row that set `key` to
+    /// `value` (rows added after the table came in name no commit).
+    BeforeRow(&'static str, &'static str),
+}
+
+impl Build {
+    fn placement(&self) -> Placement {
+        match *self {
+            Build::Before(commit) => Placement::of(None, Some(&parent_of(commit))),
+            Build::BeforeRow(key, value) => {
+                let row = CHANGES
+                    .iter()
+                    .position(|row| row.key == key && row.value == value)
+                    .unwrap_or_else(|| panic!("no row sets {key} to {value}"));
+                Placement::Rows(row)
+            }
+        }
+    }
+}
+
+/// Every earlier model under `configs/` and the builds that had it as
+/// their defaults.
+const MODELS: [(&str, Build); 8] = [
+    ("previous-defaults.toml", Build::Before("95ee59b")),
+    ("fitted-incremental.toml", Build::Before("d497677")),
+    ("scored-on-original.toml", Build::Before("a1ccaad")),
+    ("symmetric-heading.toml", Build::Before("a70d696")),
+    ("positive-heading.toml", Build::Before("8cf59c9")),
+    (
+        "task2-towards-target.toml",
+        Build::BeforeRow("problem.tasks.task2_spin", "-1.5"),
+    ),
+    (
+        "clockwise-start.toml",
+        Build::BeforeRow("problem.tasks.task2_spin", "-0.75"),
+    ),
+    ("noiseless-bias.toml", Build::BeforeRow("problem.noise.on_bias", "true")),
 ];
 
+/// The files under `configs/` that are no build's defaults: the fit's
+/// starting point (the previous defaults with the paper's stagnation
+/// rule) and the paper's words.
+const NOT_MODELS: [&str; 2] = ["fit-stage1.toml", "text.toml"];
+
+/// A table value (TOML) and the defaults table's (JSON) are the same value.
+fn same_value(file: &toml::Value, table: &serde_json::Value) -> bool {
+    let file = serde_json::to_value(file).unwrap();
+    match (file.as_f64(), table.as_f64()) {
+        (Some(a), Some(b)) => a == b,
+        _ => file == *table,
+    }
+}
+
 #[test]
-fn the_table_of_defaults_gives_each_earlier_model_of_configs_its_values() {
-    for (config, changed) in MODELS {
-        let text = std::fs::read_to_string(repo(config)).unwrap();
+fn the_table_of_defaults_gives_each_earlier_model_of_configs_exactly_its_values() {
+    // Every file under configs/ is listed, as a build's model or as none.
+    let mut files: Vec<String> = std::fs::read_dir(repo("configs"))
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().into_string().unwrap())
+        .collect();
+    files.sort();
+    let mut listed: Vec<String> = MODELS.iter().map(|(file, _)| file.to_string()).collect();
+    listed.extend(NOT_MODELS.iter().map(|file| file.to_string()));
+    listed.sort();
+    assert_eq!(files, listed, "configs/ against the lists of this test");
+
+    let today = Placement::Rows(CHANGES.len());
+    for (file, build) in &MODELS {
+        let text = std::fs::read_to_string(repo("configs").join(file)).unwrap();
         let table: toml::Table = toml::from_str(&text).unwrap();
-        let placement = Placement::of(None, Some(&parent_of(changed)));
-        let mut checked = 0;
-        for row in CHANGES {
+        let placement = build.placement();
+        let mut keys: Vec<&str> = CHANGES.iter().map(|row| row.key).collect();
+        keys.dedup();
+        keys.sort();
+        keys.dedup();
+        for key in keys {
             let mut at = Some(&table);
-            let mut parts: Vec<&str> = row.key.split('.').collect();
+            let mut parts: Vec<&str> = key.split('.').collect();
             let last = parts.pop().unwrap();
             for part in parts {
                 at = at.and_then(|t| t.get(part)).and_then(|v| v.as_table());
             }
-            let Some(value) = at.and_then(|t| t.get(last)) else {
-                continue;
-            };
-            let value: serde_json::Value = serde_json::to_value(value).unwrap();
-            let table_value = value_at(row.key, &placement).unwrap().unwrap();
-            let same = match (value.as_f64(), table_value.as_f64()) {
-                (Some(a), Some(b)) => a == b,
-                _ => value == table_value,
-            };
-            assert!(
-                same,
-                "{config}: {} = {value} there, {table_value} in the table",
-                row.key
-            );
-            checked += 1;
+            let then = value_at(key, &placement).unwrap().unwrap();
+            match at.and_then(|t| t.get(last)) {
+                // The file sets the key: to the model's value.
+                Some(value) => assert!(
+                    same_value(value, &then),
+                    "configs/{file}: {key} = {value} there, {then} in the table"
+                ),
+                // It leaves it to the defaults: which must be the model's.
+                None => {
+                    let now = value_at(key, &today).unwrap().unwrap();
+                    assert_eq!(
+                        now, then,
+                        "configs/{file} does not set {key}, whose default has changed since"
+                    );
+                }
+            }
         }
-        assert!(checked >= 4, "{config}: only {checked} keys of the table checked");
     }
 }
 
@@ -362,8 +425,12 @@ fn replayed(dir: &Path, name: &str, json: &serde_json::Value) -> f64 {
 #[test]
 fn a_champion_of_each_earlier_model_replays_to_its_recorded_fitness_bit_for_bit_as_an_old_file() {
     let dir = tempfile::tempdir().unwrap();
-    for (i, (config, changed)) in MODELS.iter().enumerate() {
-        let (recorded, mut old) = champion_of(dir.path(), &format!("run{i}"), config, "1");
+    // The models of the builds before the table (whose files name their
+    // commit, not the table's rows).
+    for (i, (file, build)) in MODELS.iter().enumerate() {
+        let Build::Before(changed) = build else { continue };
+        let config = format!("configs/{file}");
+        let (recorded, mut old) = champion_of(dir.path(), &format!("run{i}"), &config, "1");
         // The champion as the build of its model would have written it:
         // none of the settings that build did not have yet.
         as_file_of(&mut old, &parent_of(changed));

@@ -4,7 +4,9 @@
 //! and every relative link in the project's Markdown
 //! (README.md, CHANGELOG.md, CONTRIBUTING.md, docs/) reaches a file and,
 //! where it names one, a heading of it; every `docs/*.md` a source,
-//! manifest or script cites exists.
+//! manifest or script cites exists; every file, test and test file
+//! CONTRIBUTING.md cites exists; the Python stub names the backends and
+//! algorithms as the crates do.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -358,4 +360,91 @@ fn every_doc_a_source_file_cites_exists() {
         }
     }
     assert!(missing.is_empty(), "docs cited but missing:\n{}", missing.join("\n"));
+}
+
+/// The names inside each `Literal[...]` that follows `marker` in the
+/// Python stub, `python/psa_esp/_native.pyi`.
+fn stub_literals(marker: &str) -> Vec<Vec<String>> {
+    let stub = std::fs::read_to_string(root().join("python/psa_esp/_native.pyi")).unwrap();
+    stub.match_indices(marker)
+        .map(|(at, _)| {
+            let rest = &stub[at + marker.len()..];
+            let inside = rest
+                .strip_prefix("Literal[")
+                .unwrap_or_else(|| panic!("the stub's {marker:?} at byte {at} is not a Literal of names"));
+            let inside = &inside[..inside.find(']').unwrap()];
+            inside
+                .split(',')
+                .map(|name| name.trim().trim_matches('"').to_string())
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn the_python_stubs_names_are_the_crates() {
+    use psa_experiment::Algorithm;
+    use psa_sim::named::Named;
+    use psa_sim::physics::BackendKind;
+    let backends = stub_literals("backend: ");
+    for names in backends {
+        assert_eq!(names, BackendKind::names(), "a backend argument of the stub");
+    }
+    let mut read = Algorithm::names();
+    read.push("hill-climb");
+    assert_eq!(stub_literals("algorithm: "), [read], "Run's algorithm argument");
+    assert_eq!(
+        stub_literals("def algorithm(self) -> "),
+        [Algorithm::names()],
+        "Run.algorithm"
+    );
+}
+
+/// The code spans (`...`) of `markdown` on one line each.
+fn code_spans(markdown: &str) -> Vec<&str> {
+    markdown
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|span| !span.is_empty() && !span.contains('\n'))
+        .collect()
+}
+
+#[test]
+fn every_file_test_and_test_file_contributing_cites_exists() {
+    let guide = std::fs::read_to_string(root().join("CONTRIBUTING.md")).unwrap();
+    let rust: String = citing_files()
+        .iter()
+        .filter(|file| file.extension().is_some_and(|e| e == "rs"))
+        .map(|file| std::fs::read_to_string(file).unwrap_or_default())
+        .collect();
+    // A folder inside a crate is cited from its `src/` ("psa/settings/").
+    let sources = ["", "sim/src", "experiment/src", "esp/src", "src", "python/src"];
+    let mut missing = Vec::new();
+    for span in code_spans(&guide) {
+        let path_like = span.contains('/')
+            && !span.starts_with('-')
+            && span.chars().all(|c| c.is_ascii_alphanumeric() || "_-./".contains(c));
+        if path_like && !sources.iter().any(|src| root().join(src).join(span).exists()) {
+            missing.push(format!("file {span}"));
+        }
+        let test_like = span.split('_').count() >= 4
+            && span
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        if test_like && !rust.contains(&format!("fn {span}(")) {
+            missing.push(format!("test {span}"));
+        }
+        for word in span.split(" --test ").skip(1) {
+            let name = word.split_whitespace().next().unwrap_or("");
+            if name != "NAME" && !root().join("tests").join(format!("{name}.rs")).exists() {
+                missing.push(format!("test file tests/{name}.rs"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "CONTRIBUTING.md cites what is not there:\n{}",
+        missing.join("\n")
+    );
 }

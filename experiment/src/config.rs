@@ -12,15 +12,33 @@ use psa_sim::named::Named;
 use psa_sim::psa::PsaSettings;
 use strum::VariantArray;
 
-/// Which search algorithm.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// Which search algorithm (read and written by name: [`Named`]).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum Algorithm {
     /// Enforced Sub-Populations.
     Esp,
     /// The hill-climber (also read as "hill-climb", its preset's name).
     #[serde(alias = "hill-climb")]
+    #[strum(to_string = "hill_climb", serialize = "hill-climb")]
     HillClimb,
+}
+
+impl Named for Algorithm {
+    const WHAT: &'static str = "algorithm";
 }
 
 /// Everything that defines a run but its task and seed; written beside

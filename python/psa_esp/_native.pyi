@@ -52,7 +52,7 @@ def reference_evaluations_per_second(
     """Networks per second of the crate's own batched evaluation (what
     ``psa-esp bench`` times), one rate per round: the benchmark's reference."""
 
-def resolve_config(config: Config = None, *, preset: str = "baseline", backend: str | None = None) -> str:
+def resolve_config(config: Config = None, *, preset: str = "baseline", backend: Literal["ode", "native", "rapier"] | None = None) -> str:
     """The whole configuration ``config`` resolves to, as TOML."""
 
 class Ticket:
@@ -89,7 +89,7 @@ class Run:
         seed: SupportsIndex | None = 1,
         config: Config = None,
         preset: str = "baseline",
-        backend: str | None = None,
+        backend: Literal["ode", "native", "rapier"] | None = None,
         inputs: SupportsIndex | None = None,
         outputs: SupportsIndex | None = None,
         generations: SupportsIndex | None = None,
@@ -157,7 +157,7 @@ class Network:
         lesioned: npt.NDArray[np.bool_] | None = None,
         provenance: Mapping[str, Any] | None = None,
         preset: str = "baseline",
-        backend: str | None = None,
+        backend: Literal["ode", "native", "rapier"] | None = None,
     ) -> None: ...
     @property
     def weights(self) -> npt.NDArray[np.float64]:
@@ -205,7 +205,7 @@ class Trial:
         config: Config = None,
         *,
         preset: str = "baseline",
-        backend: str | None = None,
+        backend: Literal["ode", "native", "rapier"] | None = None,
         random_init: bool | None = None,
     ) -> None: ...
     def reset(self, seed: int) -> npt.NDArray[np.float64]: ...

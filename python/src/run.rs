@@ -272,16 +272,11 @@ fn fitness_values(fitness: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     })
 }
 
-/// The algorithm named `name`: `"esp"`, or `"hill_climb"` (also spelt
-/// `"hill-climb"`, as its preset is).
+/// The algorithm named `name` ([`Algorithm`]'s names; the hill-climber
+/// also as `"hill-climb"`, as its preset is spelt).
 fn algorithm_named(name: &str) -> PyResult<Algorithm> {
-    match name {
-        "esp" => Ok(Algorithm::Esp),
-        "hill_climb" | "hill-climb" => Ok(Algorithm::HillClimb),
-        other => Err(PyValueError::new_err(format!(
-            "algorithm must be \"esp\" or \"hill_climb\" (or \"hill-climb\"), got {other:?}"
-        ))),
-    }
+    name.parse()
+        .map_err(|e: String| PyValueError::new_err(format!("algorithm: {e}")))
 }
 
 impl Run {
@@ -450,10 +445,7 @@ impl Run {
     /// `"esp"` or `"hill_climb"`.
     #[getter]
     fn algorithm(&self) -> &'static str {
-        match self.config.algorithm {
-            Algorithm::Esp => "esp",
-            Algorithm::HillClimb => "hill_climb",
-        }
+        self.config.algorithm.name()
     }
 
     /// The run's whole configuration as TOML (a run folder's `config.toml`).

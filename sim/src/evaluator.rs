@@ -90,7 +90,7 @@ impl EvalPath {
     }
 
     /// The backend the path flies on, if it needs one.
-    fn backend(&self) -> Option<BackendKind> {
+    pub fn backend(&self) -> Option<BackendKind> {
         match self {
             EvalPath::Fastest | EvalPath::Scalar => None,
             EvalPath::OdeLockstep => Some(BackendKind::Ode),

@@ -40,7 +40,7 @@ pub trait Named: VariantArray + Copy + Into<&'static str> + 'static {
 mod tests {
     use super::*;
     use crate::numeric::SimdLevel;
-    use crate::physics::BackendKind;
+    use crate::physics::{BackendKind, PlaneConstraint, Stepper};
 
     /// The names of earlier builds, which result files and command lines
     /// hold: a new variant adds its name, none changes.
@@ -48,6 +48,23 @@ mod tests {
     fn the_names_are_those_of_earlier_builds() {
         assert_eq!(SimdLevel::names(), ["portable", "avx2", "avx512"]);
         assert_eq!(BackendKind::names(), ["ode", "native", "rapier"]);
+        assert_eq!(Stepper::names(), ["exact", "quick"]);
+        assert_eq!(PlaneConstraint::names(), ["none", "plane2d_joint"]);
+    }
+
+    /// A configuration file and a command line spell a value alike: each
+    /// name is the one serde writes.
+    #[test]
+    fn each_name_is_the_configurations_spelling() {
+        fn spelt<T: Named + serde::Serialize>() {
+            for &value in T::VARIANTS {
+                assert_eq!(serde_json::to_value(value).unwrap(), value.name(), "{}", T::WHAT);
+            }
+        }
+        spelt::<SimdLevel>();
+        spelt::<BackendKind>();
+        spelt::<Stepper>();
+        spelt::<PlaneConstraint>();
     }
 
     #[test]

@@ -6,18 +6,16 @@ use clap::builder::{PossibleValuesParser, TypedValueParser};
 use std::sync::Arc;
 
 use psa_sim::evaluator::EvalPath;
+use psa_sim::named::Named;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::cuda::CudaTrials;
 
-/// Where the trials of a run fly.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+/// Where the trials of a run fly: a physics backend (every
+/// [`BackendKind`], by its name), or `cuda`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BackendArg {
-    /// The Open Dynamics Engine (the faithful reference).
-    Ode,
-    /// Pure Rust, ODE's step bit for bit, batched in SIMD.
-    Native,
-    /// rapier2d-f64.
-    Rapier,
+    /// The runs fly on this backend.
+    Physics(BackendKind),
     /// `native`'s physics on an NVIDIA GPU (the `cuda` build feature):
     /// the same results bit for bit; a grid runs in lockstep, every run's
     /// generation in one launch.
@@ -25,12 +23,24 @@ pub enum BackendArg {
 }
 
 impl BackendArg {
+    /// The name of [`BackendArg::Cuda`].
+    const CUDA: &'static str = "cuda";
+
+    /// The parser of `--backend`: every backend's name, then `cuda`.
+    pub fn parser() -> impl TypedValueParser<Value = BackendArg> {
+        let mut names = BackendKind::names();
+        names.push(Self::CUDA);
+        PossibleValuesParser::new(names).map(|name| match name.as_str() {
+            Self::CUDA => BackendArg::Cuda,
+            backend => BackendArg::Physics(backend.parse().expect("clap admits only the backends' names")),
+        })
+    }
+
     /// The physics backend the runs record and simulate: `native` for `cuda`.
     pub fn physics(self) -> BackendKind {
         match self {
-            BackendArg::Ode => BackendKind::Ode,
-            BackendArg::Native | BackendArg::Cuda => BackendKind::Native,
-            BackendArg::Rapier => BackendKind::Rapier,
+            BackendArg::Physics(kind) => kind,
+            BackendArg::Cuda => BackendKind::Native,
         }
     }
 

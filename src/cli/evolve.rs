@@ -32,7 +32,7 @@ pub struct EvolveArgs {
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Physics backend, overriding the configuration (`cuda`: native's physics on the GPU).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = BackendArg::parser())]
     pub backend: Option<BackendArg>,
     /// Where the networks are evaluated.
     #[command(flatten)]

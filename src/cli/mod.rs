@@ -27,7 +27,9 @@ mod simulate;
 mod sweep;
 mod traces;
 
+use choice::choice;
 use clap::{Parser, Subcommand};
+use psa_sim::physics::{PlaneConstraint, Stepper};
 
 /// The exit code of a run whose checks failed (a cross-check out of tolerance).
 pub const EXIT_CHECK_FAILED: i32 = 1;
@@ -91,32 +93,24 @@ pub struct PhysicsArgs {
     #[arg(long, default_value_t = psa_sim::physics::StepSettings::default().dt, allow_negative_numbers = true)]
     pub dt: f64,
     /// ODE stepper: exact (dWorldStep) or quick (dWorldQuickStep).
-    #[arg(long, value_parser = ["exact", "quick"], default_value = "exact")]
-    pub stepper: String,
-    /// How ODE keeps the body in the plane: none or plane2d (a Plane2D joint).
-    #[arg(long, value_parser = ["none", "plane2d"], default_value = "none")]
-    pub plane: String,
+    #[arg(long, value_parser = choice::<Stepper>(), default_value_t = Stepper::Exact)]
+    pub stepper: Stepper,
+    /// How ODE keeps the body in the plane: none, or plane2d_joint (a
+    /// Plane2D joint), as `physics.plane_constraint` spells them.
+    #[arg(long, value_parser = choice::<PlaneConstraint>(), default_value_t = PlaneConstraint::None)]
+    pub plane: PlaneConstraint,
 }
 
 impl PhysicsArgs {
     /// The step settings these options describe; `--dt` must be in the
     /// range of `physics.dt` ([`psa_sim::psa::settings::limits`]).
     pub fn settings(&self) -> anyhow::Result<psa_sim::physics::StepSettings> {
-        use psa_sim::physics::{PlaneConstraint, StepSettings, Stepper};
         psa_sim::psa::settings::limits::check_as("physics.dt", "--dt", self.dt).map_err(anyhow::Error::msg)?;
-        let settings = StepSettings {
+        let settings = psa_sim::physics::StepSettings {
             dt: self.dt,
-            stepper: if self.stepper == "quick" {
-                Stepper::Quick
-            } else {
-                Stepper::Exact
-            },
-            plane_constraint: if self.plane == "plane2d" {
-                PlaneConstraint::Plane2dJoint
-            } else {
-                PlaneConstraint::None
-            },
-            ..StepSettings::default()
+            stepper: self.stepper,
+            plane_constraint: self.plane,
+            ..psa_sim::physics::StepSettings::default()
         };
         settings.validate()?;
         Ok(settings)

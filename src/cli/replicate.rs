@@ -64,7 +64,7 @@ pub struct GridArgs {
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=MAX_GENERATIONS as u64))]
     pub generations: Option<u64>,
     /// Physics backend (`cuda`: native's physics on the GPU, the runs in lockstep).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = BackendArg::parser())]
     pub backend: Option<BackendArg>,
     /// Fly every champion again on ode after its run on native: its fitness
     /// and robustness results must be bit-identical, recorded in run.json

@@ -92,9 +92,22 @@ pub fn wrap_angle(angle: f64) -> f64 {
     crate::numeric::wrap_angle(angle)
 }
 
-/// ODE's stepper.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// ODE's stepper (read and written by name: [`Named`]).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum Stepper {
     /// `dWorldStep`, the exact (direct LCP) stepper. `[chosen, spec]`
     Exact,
@@ -102,9 +115,23 @@ pub enum Stepper {
     Quick,
 }
 
-/// How the ODE body is held in the plane.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// How the ODE body is held in the plane (read and written by name:
+/// [`Named`]).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    strum::VariantArray,
+    strum::IntoStaticStr,
+    strum::Display,
+    strum::EnumString,
+)]
 #[serde(rename_all = "snake_case")]
+#[strum(serialize_all = "snake_case", parse_err_ty = String, parse_err_fn = Self::unknown)]
 pub enum PlaneConstraint {
     /// No joint: exact for this body, whose forces and thrusters all lie in
     /// the mid-plane, and about twice as fast. Default: the test
@@ -235,6 +262,14 @@ impl BackendKind {
 
 impl Named for BackendKind {
     const WHAT: &'static str = "backend";
+}
+
+impl Named for Stepper {
+    const WHAT: &'static str = "stepper";
+}
+
+impl Named for PlaneConstraint {
+    const WHAT: &'static str = "plane constraint";
 }
 
 /// One simulated body: reset it to a state, push it, read its state back.
