@@ -70,8 +70,8 @@ pub use esp::{BurstMode, Credit, EraseAt, Esp, EspRun, EspSettings, Relesion, Sa
 pub use evaluator::{evaluate_all, evaluate_each, evaluate_each_part, Evaluator, FnEvaluator, Part};
 pub use hill_climb::{HillClimb, HillClimbRun, HillClimbSettings, MutationRates};
 pub use limits::{
-    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_REAL_SETTING, MAX_SUBPOP_SIZE, MAX_TRIALS_PER_NEURON,
-    MIN_CAUCHY_LIMIT_PER_SCALE, MIN_SUBPOP_SIZE,
+    MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_NETWORK_SIDE, MAX_REAL_SETTING, MAX_SUBPOP_SIZE,
+    MAX_TRIALS_PER_NEURON, MIN_CAUCHY_LIMIT_PER_SCALE, MIN_SUBPOP_SIZE,
 };
 pub use progress::progress;
 /// The random number crate whose traits draw from a [`rng::Stream`]

@@ -40,6 +40,12 @@ pub const MAX_HIDDEN: usize = 100;
 /// 4-output network that is about 1 GB.
 pub const MAX_NETWORKS_PER_GENERATION: usize = 100_000;
 
+/// The most inputs or outputs of a network an ask-and-tell run evolves
+/// (the PSA's: 7 and 4). A generation holds every network's weights: at
+/// this size, [`MAX_HIDDEN`] neurons and the paper's 400 networks, about
+/// 0.6 GB.
+pub const MAX_NETWORK_SIDE: usize = 1_000;
+
 /// The smallest Cauchy limit, as a multiple of the largest Cauchy scale of
 /// a run. A draw `alpha tan(pi u)` is accepted with probability
 /// `(2 / pi) atan(limit / alpha)`: at least 6.3 % at this ratio, so the

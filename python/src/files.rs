@@ -11,14 +11,15 @@ use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::RunConfig;
 use psa_sim::named::Named;
 use psa_sim::psa::settings::limits::{check_as, MAX_TRIALS};
-use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
+use psa_sim::psa::{NetworkFile, NoiseSettings, PsaSettings, Task, TrialRunner, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyModule};
 
+use crate::args;
 use crate::config::{overlay, run_config, type_name};
 use crate::errors;
-use crate::evaluate::{task_of, REPLAY_STREAM};
+use crate::evaluate::{task_arg, REPLAY_STREAM};
 use crate::weights::{network_arrays, networks_from};
 
 /// A JSON value as the Python value `json.loads` makes of it.
@@ -58,19 +59,22 @@ impl Network {
 #[pymethods]
 impl Network {
     #[new]
-    #[pyo3(signature = (weights, task=1, config=None, *, lesioned=None, provenance=None, preset="baseline", backend=None))]
+    #[pyo3(signature = (weights, task=None, config=None, *, lesioned=None, provenance=None, preset="baseline", backend=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         weights: &Bound<'_, PyAny>,
-        task: u8,
+        task: Option<&Bound<'_, PyAny>>,
         config: Option<&Bound<'_, PyAny>>,
         lesioned: Option<&Bound<'_, PyAny>>,
         provenance: Option<&Bound<'_, PyDict>>,
         preset: &str,
         backend: Option<&str>,
     ) -> PyResult<Network> {
-        let task = task_of(task)?;
+        // Task 1 when left out (or None).
+        let task = task
+            .filter(|task| !task.is_none())
+            .map_or(Ok(Task::StopRotation), task_arg)?;
         let network = networks_from(weights, INPUT_COUNT, THRUSTER_COUNT, lesioned, true)?
             .pop()
             .expect("one network");
@@ -208,23 +212,29 @@ pub fn load_network(path: PathBuf) -> PyResult<Network> {
 /// (`default_model=True`: this build's default model), with `config`
 /// laid over it; the noise and random starts are the arguments'.
 #[pyfunction]
-#[pyo3(signature = (network, task=None, *, backend="ode", input_noise=0.0, output_noise=0.0, random_init=false, trials=1, seed=1, config=None, default_model=false))]
+#[pyo3(signature = (network, task=None, *, backend="ode", input_noise=0.0, output_noise=0.0, random_init=false, trials=None, seed=None, config=None, default_model=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn replay<'py>(
     py: Python<'py>,
     network: &Bound<'py, PyAny>,
-    task: Option<u8>,
+    task: Option<&Bound<'py, PyAny>>,
     backend: &str,
     input_noise: f64,
     output_noise: f64,
     random_init: bool,
-    trials: u64,
-    seed: u64,
+    trials: Option<&Bound<'py, PyAny>>,
+    seed: Option<&Bound<'py, PyAny>>,
     config: Option<&Bound<'py, PyAny>>,
     default_model: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_as("noise.input_sd", "input_noise", input_noise).map_err(PyValueError::new_err)?;
     check_as("noise.output_sd", "output_noise", output_noise).map_err(PyValueError::new_err)?;
+    // trials and seed: 1 when left out (or None), as `psa-esp replay`'s.
+    let trials = args::optional_count(trials, "trials")?.unwrap_or(1) as u64;
+    let seed = match seed.filter(|seed| !seed.is_none()) {
+        Some(seed) => args::seed(seed, "seed")?,
+        None => 1,
+    };
     if !(1..=MAX_TRIALS).contains(&trials) {
         return Err(PyValueError::new_err(format!(
             "trials must be in [1, {MAX_TRIALS}], got {trials}"
@@ -245,8 +255,8 @@ pub fn replay<'py>(
         }
     };
     let task = match task {
-        Some(task) => task_of(task)?,
-        None => network.file.task,
+        Some(task) if !task.is_none() => task_arg(task)?,
+        _ => network.file.task,
     };
     if random_init && !task.has_random_init() {
         return Err(PyValueError::new_err(format!(

@@ -5,7 +5,9 @@
 use std::path::PathBuf;
 
 use esp_neuroevolution::network::{Network, NetworkSet};
-use esp_neuroevolution::{AnyRun, AskPurpose, AskTell, Esp, GenerationRecord, HillClimb, RunError, RunResult, StopAt};
+use esp_neuroevolution::{
+    AnyRun, AskPurpose, AskTell, Esp, GenerationRecord, HillClimb, RunError, RunResult, StopAt, MAX_NETWORK_SIDE,
+};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use psa_experiment::{Algorithm, RunConfig, RunStart};
 use psa_sim::evaluator::PsaEvaluator;
@@ -17,7 +19,7 @@ use pyo3::types::PyDict;
 
 use crate::args::{self, SeedArg};
 use crate::config::{run_config, type_name};
-use crate::evaluate::{eval_path, pool, task_arg, task_of, DEFAULT_SEED};
+use crate::evaluate::{eval_path, pool, task_arg, DEFAULT_SEED};
 use crate::files::restorer;
 use crate::weights::{arrays_of, float_array, networks_from};
 use crate::{errors, records};
@@ -350,10 +352,25 @@ impl Run {
             SeedArg::Default => DEFAULT_SEED,
             SeedArg::Given(seed) => args::seed_or_fresh(py, Some(&seed), "seed")?,
         };
-        let inputs = args::optional_count(inputs, "inputs")?.unwrap_or(INPUT_COUNT);
-        let outputs = args::optional_count(outputs, "outputs")?.unwrap_or(THRUSTER_COUNT);
+        let side = |value, name: &str, default| -> PyResult<usize> {
+            let n = args::optional_count(value, name)?.unwrap_or(default);
+            if !(1..=MAX_NETWORK_SIDE).contains(&n) {
+                return Err(PyValueError::new_err(format!(
+                    "{name} must be in [1, {MAX_NETWORK_SIDE}], got {n}"
+                )));
+            }
+            Ok(n)
+        };
+        let inputs = side(inputs, "inputs", INPUT_COUNT)?;
+        let outputs = side(outputs, "outputs", THRUSTER_COUNT)?;
         let generations = args::optional_count(generations, "generations")?;
-        let max_evaluations = args::optional_count(max_evaluations, "max_evaluations")?.map(|n| n as u64);
+        let max_evaluations = args::optional_count(max_evaluations, "max_evaluations")?;
+        if max_evaluations == Some(0) {
+            return Err(PyValueError::new_err(
+                "max_evaluations must be at least 1 (a run evaluates a whole generation before it can stop), got 0",
+            ));
+        }
+        let max_evaluations = max_evaluations.map(|n| n as u64);
         let mut config = run_config(config, preset, backend)?;
         if let Some(algorithm) = algorithm {
             config.algorithm = algorithm_named(algorithm)?;
@@ -647,8 +664,8 @@ impl Run {
     /// `psa-esp evolve` writes `champion.json` (with the configuration's
     /// name, the seed, the fitness, the generation and the backend in its
     /// provenance), for `task`. `psa-esp replay` flies it.
-    fn save_champion(&self, path: PathBuf, task: u8) -> PyResult<()> {
-        let task = task_of(task)?;
+    fn save_champion(&self, path: PathBuf, task: &Bound<'_, PyAny>) -> PyResult<()> {
+        let task = task_arg(task)?;
         let result = self.ended()?;
         let champion = &result.champion;
         let mut extra = serde_json::Map::new();

@@ -8,7 +8,7 @@ use std::f64::consts::{PI, TAU};
 
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
-use psa_experiment::plots::{trial_frame, TrialPicture, FIGURE_HEIGHT, FIGURE_WIDTH};
+use psa_experiment::plots::{ensure_font, trial_frame, TrialPicture, FIGURE_HEIGHT, FIGURE_WIDTH};
 use psa_sim::named::Named;
 use psa_sim::numeric::{clamp_unit, NoiseSource};
 use psa_sim::physics::{create_backend, BodyState, PhysicsBackend, PlanarState};
@@ -17,9 +17,10 @@ use psa_sim::psa::{HeadingWrap, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
+use crate::args;
 use crate::config::{run_config, type_name};
 use crate::errors;
-use crate::evaluate::{task_of, REPLAY_STREAM};
+use crate::evaluate::{task_arg, REPLAY_STREAM};
 
 /// The heading input's place among the inputs (x, y, vx, vy, heading,
 /// omega, bias).
@@ -92,13 +93,13 @@ impl Trial {
     #[new]
     #[pyo3(signature = (task, config=None, *, preset="baseline", backend=None, random_init=None))]
     fn new(
-        task: u8,
+        task: &Bound<'_, PyAny>,
         config: Option<&Bound<'_, PyAny>>,
         preset: &str,
         backend: Option<&str>,
         random_init: Option<bool>,
     ) -> PyResult<Trial> {
-        let task = task_of(task)?;
+        let task = task_arg(task)?;
         let mut problem = run_config(config, preset, backend)?.problem;
         if let Some(random_init) = random_init {
             problem.random_init = random_init;
@@ -118,7 +119,8 @@ impl Trial {
     /// Starts a trial with the random stream of `seed` (the start, under
     /// random initialisation, and the noise are drawn from it); returns
     /// the first observation, the network's 7 inputs.
-    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn reset<'py>(&mut self, py: Python<'py>, seed: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let seed = args::seed(seed, "seed")?;
         let s = &self.settings;
         let mut rng = stream(seed, &[REPLAY_STREAM]);
         let (start, target) = s.tasks.start_and_target(self.task, s.random_init, &mut rng);
@@ -314,6 +316,9 @@ impl Trial {
             heading_window: s.fitness.heading_window,
             hull_radius: s.body.hull_radius,
         };
+        // No font is the machine's, not the trial's: a RuntimeError that
+        // names the package and PSA_ESP_FONT.
+        ensure_font().map_err(|e| PyRuntimeError::new_err(format!("render: {e:#}")))?;
         let pixels = trial_frame(&picture).map_err(|e| errors::simulation(format!("{e:#}")))?;
         let shape = (FIGURE_HEIGHT as usize, FIGURE_WIDTH as usize, 3);
         let array = Array3::from_shape_vec(shape, pixels).map_err(|e| errors::simulation(e.to_string()))?;

@@ -90,3 +90,42 @@ def test_reprs_are_readable():
     assert "{" not in repr(asked.ticket) and "Ticket {" not in repr(asked.ticket)
     climber = psa_esp.Run("hill_climb", generations=1)
     assert re.fullmatch(r"<psa_esp.Asked \d+ networks for generation 1, seed 1>", repr(climber.ask()))
+
+
+def test_replay_and_trial_integers_raise_value_error_naming_the_argument(tmp_path):
+    network = psa_esp.Network(random_networks(1)[0])
+    for kwargs in [{"trials": -1}, {"seed": -1}, {"seed": 2**64}]:
+        name = next(iter(kwargs))
+        with pytest.raises(ValueError, match=name):
+            psa_esp.replay(network, 1, backend="native", **kwargs)
+    trial = psa_esp.Trial(1, backend="native")
+    for seed in [-1, 2**64]:
+        with pytest.raises(ValueError, match="seed"):
+            trial.reset(seed)
+
+
+def test_an_environment_reset_with_a_seed_out_of_range_raises_value_error():
+    from psa_esp.env import PsaEnv
+
+    with pytest.raises(ValueError, match="seed"):
+        PsaEnv(1).reset(seed=2**64)
+
+
+def test_a_bool_is_no_task():
+    with pytest.raises(TypeError, match="task"):
+        psa_esp.Trial(True)
+    with pytest.raises(TypeError, match="task"):
+        psa_esp.Network(random_networks(1)[0], True)
+    run = psa_esp.Run(seed=1, generations=1, config={"esp": {"subpop_size": 10, "trials_per_neuron": 2}})
+    run.run_psa(1)
+    with pytest.raises(TypeError, match="task"):
+        run.save_champion("unused.json", True)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [({"inputs": 0}, "inputs"), ({"outputs": 0}, "outputs"), ({"inputs": 10**9}, "inputs"), ({"max_evaluations": 0}, "max_evaluations")],
+)
+def test_run_sizes_out_of_range_raise_value_error(kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        psa_esp.Run(**kwargs)
