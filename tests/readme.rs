@@ -6,7 +6,8 @@
 //! where it names one, a heading of it; every `docs/*.md` a source,
 //! manifest or script cites exists; every file, test and test file
 //! CONTRIBUTING.md cites exists; the Python stub names the backends and
-//! algorithms as the crates do.
+//! algorithms as the crates do; python/README.md's wheel recipe is CI's
+//! and its commands run the project's venv.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -447,4 +448,54 @@ fn every_file_test_and_test_file_contributing_cites_exists() {
         "CONTRIBUTING.md cites what is not there:\n{}",
         missing.join("\n")
     );
+}
+
+/// The lines of the fenced `sh` blocks of `markdown`.
+fn shell_lines(markdown: &str) -> Vec<String> {
+    let mut lines = Vec::new();
+    let mut inside = false;
+    for line in markdown.lines() {
+        if line.starts_with("```") {
+            inside = !inside && line.trim() == "```sh";
+            continue;
+        }
+        if inside && !line.trim().is_empty() {
+            lines.push(line.trim().to_string());
+        }
+    }
+    lines
+}
+
+#[test]
+fn the_python_readmes_commands_are_cis_and_use_the_projects_venv() {
+    let readme = std::fs::read_to_string(root().join("python/README.md")).unwrap();
+    let ci = std::fs::read_to_string(root().join(".ci/run")).unwrap();
+    let commands = shell_lines(&readme);
+    let mut wrong = Vec::new();
+    for line in &commands {
+        // The portable wheel's build and repair: the lines CI runs (which
+        // may filter their output).
+        let in_ci = ci.lines().any(|l| {
+            l.trim().strip_prefix(line.as_str()).is_some_and(|rest| {
+                let rest = rest.trim_start();
+                rest.is_empty() || rest.starts_with("2>") || rest.starts_with('|')
+            })
+        });
+        if (line.contains("maturin build") || line.contains("auditwheel repair")) && !in_ci {
+            wrong.push(format!("not a line of .ci/run: {line}"));
+        }
+        // Python runs as the project's venv's (a bare python3 cannot import
+        // the package), but where it makes the venv.
+        for command in line.split("&&") {
+            let command = command.trim();
+            if command.starts_with("python3 ") && !command.starts_with("python3 -m venv ") {
+                wrong.push(format!("not the venv's python: {command}"));
+            }
+        }
+    }
+    assert!(
+        commands.iter().any(|l| l.contains("maturin build")),
+        "python/README.md gives the wheel's build"
+    );
+    assert!(wrong.is_empty(), "python/README.md:\n{}", wrong.join("\n"));
 }
