@@ -101,6 +101,14 @@ fn the_previous_defaults_file_repeats_the_earlier_records_byte_for_byte() {
 }
 
 #[test]
+fn the_fit_stage1_file_repeats_the_records_of_an_earlier_build_byte_for_byte() {
+    // Recorded by build 55317a7 (before input noise reached the bias):
+    // the file pins every setting whose default changed since the
+    // starting point of sweeps S1-S6, so every build repeats them.
+    assert_repeats_the_golden_records("configs/fit-stage1.toml", "fit-stage1", &["baseline"]);
+}
+
+#[test]
 fn the_fitted_incremental_file_repeats_the_records_of_the_model_before_the_readings_byte_for_byte() {
     // Recorded by build bf1d0de, whose defaults the file pins.
     assert_repeats_the_golden_records(
