@@ -31,6 +31,7 @@ import argparse
 import json
 import math
 import os
+import platform
 import time
 from pathlib import Path
 
@@ -61,9 +62,39 @@ def model():
     return psa_esp.resolve_config(preset="baseline")
 
 
+def cpu():
+    """The processor: `lscpu`'s model name and CPU family (from
+    /proc/cpuinfo), or what `platform` knows elsewhere."""
+    fields = {}
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            key, _, value = line.partition(":")
+            fields.setdefault(key.strip(), value.strip())
+    except OSError:
+        pass
+    name = fields.get("model name") or platform.processor() or platform.machine()
+    return {"model": name, "family": fields.get("cpu family"), "cores": os.cpu_count()}
+
+
+def blas():
+    """NumPy's BLAS (CMA-ES's linear algebra, which decides its bits) and
+    the threads it was allowed."""
+    try:
+        info = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
+    except (KeyError, TypeError):
+        info = {}
+    return {
+        "name": info.get("name"),
+        "version": info.get("version"),
+        "configuration": info.get("openblas configuration"),
+        "threads": {var: os.environ.get(var) for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")},
+    }
+
+
 def provenance():
-    """What made a run: the build, the model's settings and the versions
-    of the package, pycma and NumPy."""
+    """What made a run: the build, the model's settings, the versions of
+    the package, pycma and NumPy, NumPy's BLAS and its threads, and the
+    processor (CMA-ES's results depend on the last two)."""
     try:
         import cma
 
@@ -74,6 +105,8 @@ def provenance():
         "build": psa_esp.build,
         "model": model(),
         "versions": {"psa_esp": psa_esp.__version__, "cma": cma_version, "numpy": np.__version__},
+        "blas": blas(),
+        "cpu": cpu(),
     }
 
 
@@ -210,8 +243,18 @@ def report(out: Path):
             )
     builds = sorted({r["build"] for r in rows})
     versions = sorted({f"pycma {r['versions']['cma']}, NumPy {r['versions']['numpy']}" for r in rows})
+    # Files of earlier builds record no BLAS or processor.
+    hosts = sorted(
+        {
+            f"{r['blas']['name']} {r['blas']['version']} on {r['cpu']['model']} (family {r['cpu']['family']})"
+            if "blas" in r
+            else "BLAS and processor not recorded"
+            for r in rows
+        }
+    )
     lines.append("")
     lines.append(f"Made on psa-esp {', '.join(builds)} ({'; '.join(versions)}), the model of `psa_esp.resolve_config()`.")
+    lines.append(f"CMA-ES's bits depend on the BLAS and the processor: {'; '.join(hosts)}.")
     table = "\n".join(lines)
     (out / "table.md").write_text(table + "\n")
     print(table)

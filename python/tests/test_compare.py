@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 
 import numpy as np
 import pytest
@@ -47,6 +48,10 @@ def test_runs_record_their_build_model_and_versions(compare):
     assert made["model"] == psa_esp.resolve_config()
     assert made["versions"]["numpy"] == np.__version__
     assert "cma" in made["versions"]
+    # CMA-ES's bits depend on NumPy's BLAS, its threads and the processor.
+    assert made["blas"]["name"] == np.show_config(mode="dicts")["Build Dependencies"]["blas"]["name"]
+    assert made["blas"]["threads"]["OPENBLAS_NUM_THREADS"] == os.environ.get("OPENBLAS_NUM_THREADS")
+    assert made["cpu"]["cores"] == os.cpu_count() and made["cpu"]["model"]
 
 
 def test_the_report_refuses_runs_of_another_model(compare, tmp_path):
