@@ -144,12 +144,13 @@ pub struct TaskSettings {
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
-    /// Task 3: initial forward (+y) speed (m/s). `[fitted]` 0.4: the paper's
-    /// Table 1 and 2 levels for task 3 (docs/sweeps/s17-task3-speed.md)
+    /// Task 3: initial forward (+y) speed (m/s). `[chosen]` 0.4: the text
+    /// gives none; fitted once (docs/sweeps/s17-task3-speed.md), it is not
+    /// told apart from 0.3 on fresh seeds (docs/sweeps/s49-task-settings-confirmation.md)
     pub task3_speed: f64,
-    /// Task 3: distance of the target along +y (m). `[fitted]` 0.40, the
-    /// middle of the random starts' range: both ends fit Tables 1 and 2 worse
-    /// (docs/sweeps/s20-task3-distance.md)
+    /// Task 3: distance of the target along +y (m). `[chosen]` 0.40, the
+    /// middle of the random starts' range (§5.1), not told apart from
+    /// 0.25 on fresh seeds (docs/sweeps/s49-task-settings-confirmation.md)
     pub task3_distance: f64,
     /// Task 3: target heading (rad). `[fitted]` 0, the start heading: the
     /// PSA turns round to brake and back again (docs/sweeps/s02-s06-task3-target-heading.md)
