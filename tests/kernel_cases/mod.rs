@@ -59,12 +59,9 @@ pub fn original_fitness_settings() -> PsaSettings {
 
 /// Every reading of the inputs and the fitness at a value other than its
 /// default, together: the test value of each row of
-/// [`READINGS`](psa_sim::psa::settings::readings::READINGS) (with the table's rows
-/// today: the heading input absolute and wrapped to (-pi, pi], the signed
-/// slowing rule, the fitness read from the true state, task 3 evolved on
-/// the original fitness over 250 steps, task 1 scored on the incremental
-/// one, which the evaluation paths ignore); first with noise on every
-/// input, the bias included, outputs and random starts, then clean.
+/// [`READINGS`](psa_sim::psa::settings::readings::READINGS), whatever rows
+/// the table holds (a new row joins without a line here); first with noise
+/// on the inputs, the outputs and random starts, then clean.
 pub fn reading_settings() -> [(&'static str, PsaSettings); 2] {
     let readings = every_test_value(noisy_settings());
     let clean = PsaSettings {
