@@ -1,8 +1,8 @@
 //! The bare sequence of ODE calls of one PSA step, and nothing else: a
 //! **benchmark reference only**, never used to simulate.
 //!
-//! Issue 6 asks that our ODE path (`OdeBackend::step` then
-//! `OdeBackend::state`) cost at most 10 % more than the ODE calls it makes.
+//! Our ODE path (`OdeBackend::step` then `OdeBackend::state`) is held to
+//! cost at most 10 % more than the ODE calls it makes.
 //! [`BareOdeLoop::run`] is that floor: per step, one raw
 //! `dBodyAddRelForceAtRelPos` per thruster, one raw `dWorldStep` (or
 //! `dWorldQuickStep`), and the raw reads `dBodyGetPosition`,
