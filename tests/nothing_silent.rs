@@ -357,10 +357,7 @@ fn the_table_of_defaults_gives_each_earlier_model_of_configs_exactly_its_values(
         let text = std::fs::read_to_string(repo("configs").join(file)).unwrap();
         let table: toml::Table = toml::from_str(&text).unwrap();
         let placement = build.placement();
-        let mut keys: Vec<&str> = CHANGES.iter().map(|row| row.key).collect();
-        keys.dedup();
-        keys.sort();
-        keys.dedup();
+        let keys: std::collections::BTreeSet<&str> = CHANGES.iter().map(|row| row.key).collect();
         for key in keys {
             let mut at = Some(&table);
             let mut parts: Vec<&str> = key.split('.').collect();
