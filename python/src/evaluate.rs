@@ -34,7 +34,7 @@ pub const REPLAY_STREAM: u64 = 301;
 pub const DEFAULT_SEED: u64 = 1;
 
 /// The task numbered `task`, or a `ValueError`.
-pub fn task_of(task: u8) -> PyResult<Task> {
+fn task_of(task: u8) -> PyResult<Task> {
     Task::try_from(task).map_err(PyValueError::new_err)
 }
 
@@ -226,14 +226,14 @@ pub fn evaluate<'py>(
 pub fn reference_evaluations_per_second(
     py: Python<'_>,
     weights: &Bound<'_, PyAny>,
-    task: u8,
+    task: &Bound<'_, PyAny>,
     rounds: usize,
     config: Option<&Bound<'_, PyAny>>,
     preset: &str,
     eval_path: &str,
     threads: Option<usize>,
 ) -> PyResult<Vec<f64>> {
-    let task = task_of(task)?;
+    let task = task_arg(task)?;
     let path = self::eval_path(eval_path)?;
     let networks = networks_from(weights, INPUT_COUNT, THRUSTER_COUNT, None, false)?;
     let problem = problem(config, preset, None, None)?;

@@ -129,3 +129,8 @@ def test_a_bool_is_no_task():
 def test_run_sizes_out_of_range_raise_value_error(kwargs, name):
     with pytest.raises(ValueError, match=name):
         psa_esp.Run(**kwargs)
+
+
+def test_the_benchmark_refuses_a_bool_as_its_task():
+    with pytest.raises(TypeError, match="task"):
+        psa_esp._native.reference_evaluations_per_second(random_networks(1), True, rounds=1)
