@@ -217,6 +217,22 @@ fn the_noiseless_bias_file_repeats_the_records_of_sweeps_s41_to_s46_byte_for_byt
     }
 }
 
+#[test]
+fn the_positive_wrap_file_repeats_the_records_of_the_confirmed_grid_byte_for_byte() {
+    // Recorded by build 373ef90, whose defaults the file pins: the heading
+    // error wrapped to [0, 2 pi).
+    let config = "configs/positive-wrap.toml";
+    assert_repeats_the_golden_records(config, "positive-wrap", &["baseline", "max-credit"]);
+    // Today's defaults wrap it to (-pi, pi]: every task flies another run.
+    for task in ["1", "2", "3"] {
+        let recorded = std::fs::read(repo(&format!("tests/golden/positive-wrap/baseline-t{task}.csv"))).unwrap();
+        assert!(
+            golden_run_records(None, "baseline", task) != recorded,
+            "task {task}: the defaults did not move"
+        );
+    }
+}
+
 /// The `records.csv` of the golden records' run (seed 7, 120 generations,
 /// native) of `preset` on `task`, with `config` laid over it if given.
 fn golden_run_records(config: Option<&Path>, preset: &str, task: &str) -> Vec<u8> {

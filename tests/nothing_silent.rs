@@ -298,7 +298,7 @@ impl Build {
             Build::BeforeRow(key, value) => {
                 let row = CHANGES
                     .iter()
-                    .position(|row| row.key == key && row.value == value)
+                    .rposition(|row| row.key == key && row.value == value)
                     .unwrap_or_else(|| panic!("no row sets {key} to {value}"));
                 Placement::Rows(row)
             }
@@ -308,7 +308,7 @@ impl Build {
 
 /// Every earlier model under `configs/` and the builds that had it as
 /// their defaults.
-const MODELS: [(&str, Build); 8] = [
+const MODELS: [(&str, Build); 9] = [
     ("previous-defaults.toml", Build::Before("95ee59b")),
     ("fitted-incremental.toml", Build::Before("d497677")),
     ("scored-on-original.toml", Build::Before("a1ccaad")),
@@ -323,6 +323,10 @@ const MODELS: [(&str, Build); 8] = [
         Build::BeforeRow("problem.tasks.task2_spin", "-0.75"),
     ),
     ("noiseless-bias.toml", Build::BeforeRow("problem.noise.on_bias", "true")),
+    (
+        "positive-wrap.toml",
+        Build::BeforeRow("problem.sensors.heading_wrap", r#""symmetric""#),
+    ),
 ];
 
 /// The files under `configs/` that are no build's defaults: the fit's
@@ -691,8 +695,16 @@ fn a_grid_of_an_earlier_build_is_reported_and_resuming_it_names_the_setting_and_
         readings.contains("(-pi, pi]"),
         "the run's own heading range: {readings}"
     );
-    // Resuming with this build's defaults: refused, naming the setting and the build.
-    refused(&psa_esp(&tiny_args(&grid)), &["heading_wrap", &parent_of("a70d696")]);
+    // Resuming with this build's defaults: refused, naming the settings
+    // (one its build did not have yet, read from the table) and the build.
+    refused(
+        &psa_esp(&tiny_args(&grid)),
+        &[
+            "esp.stagnation = 40 there",
+            "position_scale = 10.0 there",
+            &parent_of("a70d696"),
+        ],
+    );
     // Re-scoring reads it too, under its own model.
     let config = dir.path().join("rescore.toml");
     std::fs::write(&config, "[problem.fitness]\nscoring = \"incremental\"\n").unwrap();

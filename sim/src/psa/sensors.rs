@@ -28,11 +28,15 @@ pub enum HeadingInput {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum HeadingWrap {
-    /// (-pi, pi]: the default before sweep S22.
+    /// (-pi, pi]: the input is continuous where the heading crosses its
+    /// target. `[chosen]` default, the simpler range: the fitted [0, 2 pi)
+    /// was not told apart from it beyond seed noise on seeds the fit never
+    /// saw (docs/sweeps/s49-task-settings-confirmation.md)
+    #[default]
     Symmetric,
     /// [0, 2 pi): the input jumps by 2 pi where the heading crosses its
-    /// target. `[fitted]` default (docs/sweeps/s16-s21-s23-heading-range.md)
-    #[default]
+    /// target; the default from sweep S22 to S49
+    /// (docs/sweeps/s16-s21-s23-heading-range.md).
     Positive,
 }
 
@@ -65,10 +69,10 @@ pub enum NoiseStage {
 /// Input scaling: one factor, `[fitted]` 0.5, on the scales 10 per m, 10
 /// per m/s, 1 per rad and 1 per rad/s (docs/sweeps/s04-sensor-scaling.md,
 /// s39-sensor-scales.md, s41-s44-one-factor-and-task2-start.md); the
-/// inputs then lie about 0.75 to 3.1 (the box's 0.2 m, 0.4 m/s, a heading
-/// error of up to 2 pi, 1.5 rad/s), 15 to 63 times the noise (sd 0.05).
+/// inputs then lie about 0.75 to 2 (the box's 0.2 m, 0.4 m/s, a heading
+/// error of up to pi, 1.5 rad/s), 15 to 40 times the noise (sd 0.05).
 /// The text's "about two orders of magnitude" (§5.1) reads as factor 1
-/// (30 to 126 times): the fit, with task 2's start, moved away from it
+/// (30 to 80 times): the fit, with task 2's start, moved away from it
 /// (configs/text.toml; docs/model.md, "How sure the fit is").
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -85,8 +89,8 @@ pub struct SensorSettings {
     pub bias: f64,
     /// What the heading input measures. `[fitted]` error (D, S13 and S19)
     pub heading_input: HeadingInput,
-    /// The range the heading input is wrapped to. `[fitted]` positive,
-    /// [0, 2 pi) (docs/sweeps/s16-s21-s23-heading-range.md, S21 and S22)
+    /// The range the heading input is wrapped to. `[chosen]` symmetric,
+    /// (-pi, pi] (docs/sweeps/s49-task-settings-confirmation.md)
     pub heading_wrap: HeadingWrap,
 }
 

@@ -118,6 +118,7 @@ pub const CHANGES: &[Change] = &[
     first("problem.sensors.angular_velocity_scale", "1.0"),
     changed("problem.sensors.angular_velocity_scale", "", "0.5"),
     changed("problem.noise.on_bias", "", "true"),
+    changed("problem.sensors.heading_wrap", "", r#""symmetric""#),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.
@@ -319,9 +320,14 @@ mod tests {
             value_at(wrap, &at(&format!("{head}-dirty"))).unwrap(),
             Some("positive".into())
         );
+        // Back to (-pi, pi] by a later row.
+        assert_eq!(
+            value_at(wrap, &Placement::Rows(rows() - 1)).unwrap(),
+            Some("positive".into())
+        );
         assert_eq!(
             value_at(wrap, &Placement::Rows(rows())).unwrap(),
-            Some("positive".into())
+            Some("symmetric".into())
         );
         assert_eq!(value_at(wrap, &Placement::Rows(10)).unwrap(), Some("symmetric".into()));
         let err = value_at(wrap, &at("0123456789abcdef")).unwrap_err();

@@ -181,14 +181,14 @@ pub const READINGS: &[Reading] = &[
     Reading {
         key: "sensors.heading_wrap",
         doc: "the heading input's range: `symmetric`, (-pi, pi], or `positive`, [0, 2 pi)",
-        tag: Tag::Fitted,
+        tag: Tag::Chosen,
         define: Some(Define {
             name: "PSA_HEADING_POSITIVE",
             on: |s| s.sensors.heading_wrap == HeadingWrap::Positive,
         }),
         task_key: None,
         describe: Describe::With("sensors.heading_input"),
-        set_test_value: |s| s.sensors.heading_wrap = HeadingWrap::Symmetric,
+        set_test_value: |s| s.sensors.heading_wrap = HeadingWrap::Positive,
     },
     Reading {
         key: "noise.on_bias",
