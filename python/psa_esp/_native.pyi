@@ -196,7 +196,7 @@ def replay(
     """Flies a network as ``psa-esp replay`` does; what ``replay --json`` prints."""
 
 class Trial:
-    """One trial of a task, flown a control step at a time."""
+    """One trial of a task, flown a control step at a time, on the thread that made it."""
 
     inputs: int
     def __init__(

@@ -22,6 +22,7 @@ mod files;
 mod records;
 mod run;
 mod stats;
+mod thread_bound;
 mod trial;
 mod weights;
 

@@ -11,7 +11,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
 use psa_experiment::plots::{ensure_font, trial_frame, TrialPicture, FIGURE_HEIGHT, FIGURE_WIDTH};
 use psa_sim::named::Named;
 use psa_sim::numeric::{clamp_unit, NoiseSource};
-use psa_sim::physics::{create_backend, BodyState, PhysicsBackend, PlanarState};
+use psa_sim::physics::{create_backend, BodyState, PlanarState};
 use psa_sim::psa::step::{score, sense, Reading};
 use psa_sim::psa::{HeadingWrap, PsaSettings, Task, INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
@@ -21,6 +21,7 @@ use crate::args;
 use crate::config::{run_config, type_name};
 use crate::errors;
 use crate::evaluate::{task_arg, REPLAY_STREAM};
+use crate::thread_bound::ThreadBound;
 
 /// The heading input's place among the inputs (x, y, vx, vy, heading,
 /// omega, bias).
@@ -47,13 +48,14 @@ struct Flight {
 /// for `task`. `reset(seed)` starts a trial as `psa-esp replay --seed
 /// seed` starts its first (the paper's start, or a random one under
 /// `random_init`), `step(thrust)` applies four thruster commands for one
-/// step. Lives on the thread that made it (its physics world may be an
-/// ODE world).
-#[pyclass(module = "psa_esp._native", unsendable)]
+/// step. Steps only on the thread that made it (its physics world may be
+/// an ODE world): `reset` and `step` from another thread raise
+/// `RuntimeError`; its other attributes read from any thread.
+#[pyclass(module = "psa_esp._native")]
 pub struct Trial {
     settings: PsaSettings,
     task: Task,
-    backend: Box<dyn PhysicsBackend>,
+    physics: ThreadBound,
     maximum: f64,
     flight: Option<Flight>,
 }
@@ -111,7 +113,7 @@ impl Trial {
             maximum: settings.fitness.maximum(settings.steps),
             settings,
             task,
-            backend,
+            physics: ThreadBound::new(backend, "Trial"),
             flight: None,
         })
     }
@@ -124,10 +126,12 @@ impl Trial {
         let s = &self.settings;
         let mut rng = stream(seed, &[REPLAY_STREAM]);
         let (start, target) = s.tasks.start_and_target(self.task, s.random_init, &mut rng);
-        self.backend.reset(&start).map_err(errors::simulation)?;
+        let (state, body) = self
+            .physics
+            .with(|engine| engine.reset(&start).map(|()| (engine.planar_state(), engine.state())))?
+            .map_err(errors::simulation)?;
         let mut noise = NoiseSource::new(s.noise.draw_seed(&mut rng));
         let target = [target.x, target.y, target.heading];
-        let state = self.backend.planar_state();
         let reading = Trial::read(s, &state, target, &mut noise);
         let inputs = reading.inputs;
         self.flight = Some(Flight {
@@ -137,7 +141,7 @@ impl Trial {
             reading,
             points: 0.0,
             steps: 0,
-            states: vec![self.backend.state()],
+            states: vec![body],
             outputs: Vec::new(),
         });
         Ok(PyArray1::from_slice(py, &inputs))
@@ -182,9 +186,12 @@ impl Trial {
         for u in &mut outputs {
             *u = clamp_unit(*u);
         }
-        self.backend.step(&outputs).map_err(errors::simulation)?;
+        let (state, body) = self
+            .physics
+            .with(|engine| engine.step(&outputs).map(|()| (engine.planar_state(), engine.state())))?
+            .map_err(errors::simulation)?;
         let previous_omega = flight.state.omega;
-        flight.state = self.backend.planar_state();
+        flight.state = state;
         let next = Trial::read(s, &flight.state, flight.target, &mut flight.noise);
         let points = score(
             s.step(),
@@ -198,7 +205,7 @@ impl Trial {
         flight.reading = next;
         flight.points += points;
         flight.steps += 1;
-        flight.states.push(self.backend.state());
+        flight.states.push(body);
         flight.outputs.push(outputs);
         Ok((
             PyArray1::from_slice(py, &flight.reading.inputs),

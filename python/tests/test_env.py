@@ -97,3 +97,46 @@ def test_stepping_wrongly_raises_clear_exceptions():
         PsaEnv(1, {"problem": {"no_such": 1}})
     with pytest.raises(psa_esp.ConfigError, match="random-initialisation"):
         PsaEnv(2, random_init=True)
+
+
+@pytest.mark.parametrize("backend", ["native", "ode"])
+def test_an_environment_steps_on_its_own_thread_and_another_thread_gets_a_runtime_error(backend):
+    import threading
+
+    def in_thread(work):
+        """`work()` on a new thread: its result, or the exception it raised."""
+        outcome = {}
+
+        def target():
+            try:
+                outcome["value"] = work()
+            except BaseException as error:  # noqa: BLE001 - the test reads the class
+                outcome["error"] = error
+
+        thread = threading.Thread(target=target)
+        thread.start()
+        thread.join()
+        return outcome
+
+    env = PsaEnv(1, {"problem": {"backend": backend}})
+    env.reset(seed=3)
+    thrust = np.full(4, 0.5)
+    moved = in_thread(lambda: env.step(thrust))
+    # An Exception (not pyo3's PanicException, a BaseException) naming the rule.
+    assert isinstance(moved.get("error"), RuntimeError), moved
+    assert "thread that made it" in str(moved["error"])
+    moved = in_thread(lambda: env.reset(seed=3))
+    assert isinstance(moved.get("error"), RuntimeError), moved
+    # Still usable on its own thread, and its attributes read anywhere.
+    assert len(env.step(thrust)) == 5
+    assert in_thread(lambda: env.unwrapped._trial.steps_done) == {"value": 1}
+
+    # One made in each thread steps there, with the main thread's bits.
+    def episode():
+        own = PsaEnv(1, {"problem": {"backend": backend}})
+        own.reset(seed=3)
+        return [own.step(thrust)[1] for _ in range(20)]
+
+    here = episode()
+    there = in_thread(episode)
+    assert there == {"value": here}
