@@ -160,3 +160,47 @@ def test_a_config_error_is_a_value_error_and_a_package_error():
         psa_esp.evaluate(random_networks(1), 1, {"esp": {"subpop_size": 0}})
     assert isinstance(caught.value, psa_esp.PsaEspError)
     assert "subpop_size" in str(caught.value)
+
+
+def test_a_large_call_flown_in_pieces_gives_each_network_its_own_bits():
+    # More networks than one piece between two signal checks (a thread's
+    # 64 batches): the call's bits are each network's alone.
+    networks = random_networks(1500, seed=4)
+    whole = psa_esp.evaluate(networks, 1, NOISY, seed=np.arange(1500, dtype=np.uint64), threads=1)
+    parts = [
+        psa_esp.evaluate(networks[i : i + 100], 1, NOISY, seed=np.arange(i, i + 100, dtype=np.uint64), threads=1)
+        for i in range(0, 1500, 100)
+    ]
+    assert np.array_equal(whole, np.concatenate(parts))
+
+
+def test_ctrl_c_stops_a_long_evaluate_with_keyboard_interrupt():
+    import signal
+    import subprocess
+    import sys
+    import textwrap
+    import time
+
+    # Ten million trials on one thread: minutes of work, stopped by SIGINT.
+    script = textwrap.dedent(
+        """
+        import numpy as np, psa_esp, sys
+        networks = np.random.default_rng(0).uniform(-3, 3, (100_000, 5, psa_esp.GENES_PER_NEURON))
+        try:
+            print("started", flush=True)
+            psa_esp.evaluate(networks, 1, trials=100, threads=1)
+            print("finished")
+        except KeyboardInterrupt:
+            print("interrupted")
+        """
+    )
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(1)  # well inside the call, which runs for minutes
+    child.send_signal(signal.SIGINT)
+    try:
+        out, err = child.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        raise AssertionError("evaluate did not stop on SIGINT") from None
+    assert out.strip() == "interrupted", err
