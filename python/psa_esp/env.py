@@ -82,6 +82,10 @@ class PsaEnv(gymnasium.Env):
         info = {"fitness": self._trial.fitness, "state": self._trial.state}
         return observation, reward, False, truncated, info
 
+    def __repr__(self):
+        arguments = ", ".join(f"{key}={value!r}" for key, value in self._arguments.items() if value is not None and key != "task")
+        return f"PsaEnv(task={self.task!r}{', ' + arguments if arguments else ''}; {self._trial!r})"
+
     def render(self):
         """The trial so far as an (H, W, 3) uint8 array under
         ``render_mode="rgb_array"``; None without a render mode."""

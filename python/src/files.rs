@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use esp_neuroevolution::math::Exponential;
 use esp_neuroevolution::network::Network as Weights;
 use esp_neuroevolution::rng::stream;
-use numpy::{PyArray1, PyArray2};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyArrayMethods};
 use psa_experiment::champion::robustness::TrialSummary;
 use psa_experiment::RunConfig;
 use psa_sim::named::Named;
@@ -133,26 +134,49 @@ impl Network {
     }
 
     /// The network's outputs (the four thrusters, before noise and
-    /// clamping) for `inputs` (7 floats, as the environment observes
-    /// them), with the exponential of the problem it was evolved under:
-    /// the bits a trial computes.
-    fn activate<'py>(&self, py: Python<'py>, inputs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let inputs: Vec<f64> = inputs.extract().map_err(|_| {
-            PyTypeError::new_err(format!(
-                "inputs must be {INPUT_COUNT} floats, got {}",
-                type_name(inputs)
-            ))
-        })?;
-        let mut outputs = [0.0; THRUSTER_COUNT];
+    /// clamping) for `inputs`, with the exponential of the problem it was
+    /// evolved under: the bits a trial computes. `inputs` is one
+    /// observation (7 floats, as the environment observes them), giving 4
+    /// outputs, or a batch of shape (N, 7), giving (N, 4).
+    fn activate<'py>(&self, py: Python<'py>, inputs: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let array = py
+            .import("numpy")?
+            .call_method1("asarray", (inputs, "float64"))
+            .and_then(|array| Ok(array.cast_into::<PyArrayDyn<f64>>()?))
+            .map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "inputs must be {INPUT_COUNT} floats or an array of shape (N, {INPUT_COUNT}), got {}",
+                    type_name(inputs)
+                ))
+            })?;
+        let readonly = array.try_readonly().map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let view = readonly.as_array();
         let exponential: Exponential = self.recorded_problem().exponential;
-        if inputs.len() != INPUT_COUNT {
-            return Err(PyValueError::new_err(format!(
-                "inputs must be {INPUT_COUNT} floats, got {}",
-                inputs.len()
-            )));
+        let shape = view.shape().to_vec();
+        let count = match shape[..] {
+            [INPUT_COUNT] => None,
+            [count, INPUT_COUNT] => Some(count),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "inputs must be {INPUT_COUNT} floats or an array of shape (N, {INPUT_COUNT}), got shape {shape:?}"
+                )))
+            }
+        };
+        let flat: Vec<f64> = view.iter().copied().collect();
+        let mut outputs = vec![0.0; flat.len() / INPUT_COUNT * THRUSTER_COUNT];
+        for (observation, out) in flat
+            .chunks_exact(INPUT_COUNT)
+            .zip(outputs.chunks_exact_mut(THRUSTER_COUNT))
+        {
+            self.network.activate_with(exponential, observation, out);
         }
-        self.network.activate_with(exponential, &inputs, &mut outputs);
-        Ok(PyArray1::from_slice(py, &outputs))
+        Ok(match count {
+            None => PyArray1::from_vec(py, outputs).into_any(),
+            Some(count) => Array2::from_shape_vec((count, THRUSTER_COUNT), outputs)
+                .map_err(|e| PyValueError::new_err(e.to_string()))?
+                .into_pyarray(py)
+                .into_any(),
+        })
     }
 
     /// The network file as JSON text, as `save` writes it.

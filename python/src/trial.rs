@@ -291,6 +291,25 @@ impl Trial {
         (low, high)
     }
 
+    /// `Trial(task=1, backend='native', step 120 of 500, fitness 12.3 %)`,
+    /// or `not started` before the first `reset`.
+    fn __repr__(&self) -> String {
+        let progress = match &self.flight {
+            None => "not started".to_string(),
+            Some(f) => format!(
+                "step {} of {}, fitness {:.1} %",
+                f.steps,
+                self.settings.steps,
+                100.0 * f.points / self.maximum
+            ),
+        };
+        format!(
+            "Trial(task={}, backend='{}', {progress})",
+            self.task.number(),
+            self.settings.backend.name()
+        )
+    }
+
     /// The trial so far drawn as `psa-esp replay` draws its picture
     /// (`trial.png`: the path with the target box, the thrusters'
     /// commands, the heading error and spin over time), as an (H, W, 3)

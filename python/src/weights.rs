@@ -16,15 +16,32 @@ use crate::config::type_name;
 
 /// `value` as a float64 array, or a `TypeError` naming what it is. A
 /// float32 or float16 array (evosax's and EvoTorch's default dtype) is
-/// converted: every such number is a float64 exactly.
+/// converted: every such number is a float64 exactly. Anything else NumPy
+/// reads as an array (a list of equal-length arrays, as pycma's `ask()`
+/// gives, or another library's tensor) is taken as `numpy.asarray` reads
+/// it, under the same rule.
 pub fn float_array<'py>(value: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    let untyped = value.cast::<PyUntypedArray>().map_err(|_| {
-        PyTypeError::new_err(format!(
-            "{what} must be a NumPy array of float64, got {} (use numpy.asarray(..., dtype=numpy.float64))",
-            type_name(value)
-        ))
-    })?;
     let py = value.py();
+    if value.cast::<PyUntypedArray>().is_err() {
+        let hint = "(a NumPy array of float64, or a sequence of equal-length float arrays)";
+        let read = py.import("numpy")?.call_method1("asarray", (value,)).map_err(|e| {
+            PyValueError::new_err(format!(
+                "{what} must be an array {hint}; NumPy cannot read {} as one: {}",
+                type_name(value),
+                e.value(py)
+            ))
+        })?;
+        let untyped = read.cast::<PyUntypedArray>()?;
+        if untyped.dtype().kind() != b'f' {
+            return Err(PyTypeError::new_err(format!(
+                "{what} must be an array {hint}, got {} (of {})",
+                type_name(value),
+                untyped.dtype()
+            )));
+        }
+        return float_array(&read, what);
+    }
+    let untyped = value.cast::<PyUntypedArray>()?;
     let dtype_of = untyped.dtype();
     if dtype_of.is_equiv_to(&dtype::<f64>(py)) {
         return Ok(value.cast::<PyArrayDyn<f64>>()?.clone());

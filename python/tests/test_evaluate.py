@@ -105,7 +105,8 @@ def test_no_networks_is_no_fitness():
     ("weights", "error", "words"),
     [
         (random_networks(3).astype(np.int64), TypeError, "dtype int64"),
-        (random_networks(3).tolist(), TypeError, "got list"),
+        ([["a"] * 55] * 3, TypeError, "got list"),
+        ([np.zeros(55), np.zeros(44)], ValueError, "NumPy cannot read list"),
         (np.zeros((3, 5, 10)), ValueError, "10 genes per hidden neuron"),
         (np.zeros((3, 54)), ValueError, "not whole hidden neurons"),
         (np.zeros((2, 3, 5, 11)), ValueError, "4 dimensions"),
@@ -204,3 +205,17 @@ def test_ctrl_c_stops_a_long_evaluate_with_keyboard_interrupt():
         child.kill()
         raise AssertionError("evaluate did not stop on SIGINT") from None
     assert out.strip() == "interrupted", err
+
+
+def test_a_sequence_of_equal_length_arrays_is_an_array():
+    # pycma's ask() gives a list of flat arrays; other libraries' arrays
+    # (here float32 rows) are read as NumPy reads them.
+    networks = random_networks(5, seed=2)
+    flat = networks.reshape(5, -1)
+    expected = psa_esp.evaluate(networks, 2, seed=3)
+    assert np.array_equal(psa_esp.evaluate(list(flat), 2, seed=3), expected)
+    assert np.array_equal(psa_esp.evaluate(networks.tolist(), 2, seed=3), expected)
+    rows32 = [row.astype(np.float32) for row in flat]
+    assert np.array_equal(
+        psa_esp.evaluate(rows32, 2, seed=3), psa_esp.evaluate(np.stack(rows32).astype(np.float64), 2, seed=3)
+    )

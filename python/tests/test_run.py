@@ -272,3 +272,28 @@ def test_result_during_the_run_is_the_best_so_far():
     assert final["champion"]["fitness"] >= best
     assert run.result()["ending"] == final["ending"] == "completed"
     assert run.result()["champion"]["fitness"] == final["champion"]["fitness"]
+
+
+def test_a_network_activates_a_batch_as_it_activates_each_observation():
+    network = psa_esp.Network(np.random.default_rng(3).normal(size=(5, 11)), 1)
+    observations = np.random.default_rng(4).normal(size=(9, psa_esp.INPUTS))
+    batch = network.activate(observations)
+    assert batch.shape == (9, psa_esp.OUTPUTS)
+    for observation, outputs in zip(observations, batch):
+        assert np.array_equal(network.activate(observation), outputs)
+        assert np.array_equal(network.activate(observation.tolist()), outputs)
+    assert network.activate(observations[:0]).shape == (0, psa_esp.OUTPUTS)
+    with pytest.raises(ValueError, match=r"shape \(N, 7\), got shape \[9, 6\]"):
+        network.activate(observations[:, :6])
+    with pytest.raises(TypeError, match="got str"):
+        network.activate("seven")
+
+
+def test_environments_and_trials_say_what_they_are():
+    from psa_esp.env import PsaEnv
+
+    env = PsaEnv(2, preset="max-credit")
+    assert repr(env) == "PsaEnv(task=2, preset='max-credit'; Trial(task=2, backend='native', not started))"
+    env.reset(seed=1)
+    env.step(np.zeros(4))
+    assert repr(env._trial) == "Trial(task=2, backend='native', step 1 of 500, fitness 0.0 %)"
