@@ -38,6 +38,7 @@ from ._native import (
     Run,
     Ticket,
     Trial,
+    TrialBatch,
     __version__,
     build,
     evaluate,
@@ -87,6 +88,7 @@ for _task in TASKS:
         gymnasium.register(
             id=_id,
             entry_point="psa_esp.env:PsaEnv",
+            vector_entry_point="psa_esp.env:PsaVectorEnv",
             kwargs={"task": _task},
             # No TimeLimit: an episode ends with its trial, whose length
             # the configuration gives (`problem.steps`).
@@ -103,6 +105,7 @@ __all__ = [
     "Run",
     "Ticket",
     "Trial",
+    "TrialBatch",
     "__version__",
     "build",
     "errors",

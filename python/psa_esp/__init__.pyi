@@ -13,6 +13,7 @@ from ._native import (
     Run as Run,
     Ticket as Ticket,
     Trial as Trial,
+    TrialBatch as TrialBatch,
     __version__ as __version__,
     build as build,
     evaluate as evaluate,

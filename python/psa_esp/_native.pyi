@@ -229,6 +229,30 @@ class Trial:
     def frame(self) -> npt.NDArray[np.uint8]:
         """The trial so far drawn as ``psa-esp replay``'s picture, (H, W, 3)."""
 
+class TrialBatch:
+    """``count`` trials of one task stepped in one call (the native side of
+    ``psa_esp.env.PsaVectorEnv``), on the thread that made it."""
+
+    def __init__(
+        self,
+        count: int,
+        task: int,
+        config: Config = None,
+        *,
+        preset: str = "baseline",
+        backend: Literal["ode", "native", "rapier"] | None = None,
+        random_init: bool | None = None,
+    ) -> None: ...
+    def reset(self, index: int, seed: int) -> npt.NDArray[np.float64]: ...
+    def step(
+        self, thrust: npt.NDArray[np.float64], skip: npt.NDArray[np.bool_]
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+    @property
+    def fitness(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def states(self) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...
+
 def welch(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float]:
     """Welch's two-sample, two-tailed t-test of ``a`` against ``b``, as
     ``psa-esp report`` computes it: ``(t, df, p)``; NaN for all three where

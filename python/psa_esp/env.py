@@ -36,7 +36,11 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from ._native import INPUTS, OUTPUTS, Trial
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from ._native import INPUTS, OUTPUTS, Trial, TrialBatch
 
 
 
@@ -108,3 +112,79 @@ class PsaEnv(gymnasium.Env):
             self._trial.reset(self._trial_seed)
             for action in self._actions:
                 self._trial.step(action)
+
+
+class PsaVectorEnv(VectorEnv):
+    """``num_envs`` environments of one task stepped in one native call:
+    ``gymnasium.make_vec("psa_esp/Task1-v0", num_envs=64,
+    vectorization_mode="vector_entry_point")``. Each sub-environment flies
+    exactly what a :class:`PsaEnv` with the same arguments flies inside a
+    ``SyncVectorEnv`` (the same seeds, the same autoreset on the next step):
+    the same observations, rewards and endings, bit for bit."""
+
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(self, num_envs=1, task=1, config=None, *, preset="baseline", backend=None, random_init=None):
+        self.num_envs = num_envs
+        self._batch = TrialBatch(num_envs, task, config, preset=preset, backend=backend, random_init=random_init)
+        single = PsaEnv(task, config, preset=preset, backend=backend, random_init=random_init)
+        self.single_observation_space = single.observation_space
+        self.single_action_space = single.action_space
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+        self.metadata = {**PsaVectorEnv.metadata, "render_fps": single.metadata["render_fps"]}
+        self._generators = [None] * num_envs
+        self._trial_seeds = np.zeros(num_envs, dtype=np.uint64)
+        self._autoreset = np.zeros(num_envs, dtype=np.bool_)
+        self._observations = np.zeros((num_envs, INPUTS))
+
+    def _start(self, index, seed):
+        # As PsaEnv.reset: a given seed is the trial's; without one, the
+        # sub-environment's own generator draws it.
+        if seed is not None:
+            self._generators[index], _ = seeding.np_random(seed)
+            trial_seed = int(seed)
+        else:
+            if self._generators[index] is None:
+                self._generators[index], _ = seeding.np_random()
+            trial_seed = int(self._generators[index].integers(0, 2**63))
+        self._trial_seeds[index] = trial_seed
+        self._observations[index] = self._batch.reset(index, trial_seed)
+
+    def reset(self, *, seed=None, options=None):
+        """Starts every trial (or those of ``options["reset_mask"]``): an
+        int ``seed`` gives sub-environment i the seed ``seed + i``."""
+        super().reset(seed=seed)
+        if seed is None:
+            seeds = [None] * self.num_envs
+        elif isinstance(seed, (int, np.integer)):
+            seeds = [int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+        if len(seeds) != self.num_envs:
+            raise ValueError(f"seed must be an int or {self.num_envs} seeds, got {len(seeds)}")
+        mask = np.ones(self.num_envs, dtype=np.bool_)
+        if options is not None and "reset_mask" in options:
+            mask = np.asarray(options["reset_mask"], dtype=np.bool_).reshape(self.num_envs)
+        for i in np.flatnonzero(mask):
+            self._start(i, seeds[i])
+        self._autoreset[mask] = False
+        info = {"fitness": self._batch.fitness, "trial_seed": self._trial_seeds.copy(), "state": self._batch.states}
+        return self._observations.copy(), info
+
+    def step(self, actions):
+        """One control step of every trial; a trial that ended on the last
+        step is started again instead (from its generator's next seed)."""
+        actions = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, OUTPUTS)
+        restarted = self._autoreset.copy()
+        for i in np.flatnonzero(restarted):
+            self._start(i, None)
+        observations, rewards, truncated = self._batch.step(actions, restarted)
+        self._observations = observations
+        self._autoreset = truncated.copy()
+        terminated = np.zeros(self.num_envs, dtype=np.bool_)
+        info = {"fitness": self._batch.fitness, "state": self._batch.states}
+        return observations.copy(), rewards, terminated, truncated, info
+
+    def __repr__(self):
+        return f"PsaVectorEnv(num_envs={self.num_envs}, {self._batch!r})"

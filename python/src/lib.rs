@@ -24,6 +24,7 @@ mod run;
 mod stats;
 mod thread_bound;
 mod trial;
+mod trial_batch;
 mod weights;
 
 /// The native half of `psa_esp`; import `psa_esp`, not this module.
@@ -44,6 +45,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<run::Asked>()?;
     m.add_class::<run::Ticket>()?;
     m.add_class::<trial::Trial>()?;
+    m.add_class::<trial_batch::TrialBatch>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("build", psa_experiment::version())?;
     m.add("INPUTS", psa_sim::psa::INPUT_COUNT)?;

@@ -61,6 +61,106 @@ pub struct Trial {
 }
 
 impl Trial {
+    /// Starts a trial with the random stream of `seed`: the first
+    /// observation (what `reset` returns).
+    pub fn start(&mut self, seed: u64) -> PyResult<[f64; INPUT_COUNT]> {
+        let s = &self.settings;
+        let mut rng = stream(seed, &[REPLAY_STREAM]);
+        let (start, target) = s.tasks.start_and_target(self.task, s.random_init, &mut rng);
+        let (state, body) = self
+            .physics
+            .with(|engine| engine.reset(&start).map(|()| (engine.planar_state(), engine.state())))?
+            .map_err(errors::simulation)?;
+        let mut noise = NoiseSource::new(s.noise.draw_seed(&mut rng));
+        let target = [target.x, target.y, target.heading];
+        let reading = Trial::read(s, &state, target, &mut noise);
+        let inputs = reading.inputs;
+        self.flight = Some(Flight {
+            target,
+            noise,
+            state,
+            reading,
+            points: 0.0,
+            steps: 0,
+            states: vec![body],
+            outputs: Vec::new(),
+        });
+        Ok(inputs)
+    }
+
+    /// Applies `outputs` for one step (what `step` does once its argument
+    /// is read): the next observation and the step's reward.
+    pub fn advance(&mut self, mut outputs: [f64; THRUSTER_COUNT]) -> PyResult<([f64; INPUT_COUNT], f64)> {
+        if let Some(bad) = outputs.iter().find(|u| !u.is_finite()) {
+            return Err(PyValueError::new_err(format!("thrust must be finite, got {bad}")));
+        }
+        let steps = self.settings.steps;
+        let maximum = self.maximum;
+        let flight = self.flight.as_mut().ok_or_else(not_started)?;
+        if flight.steps >= steps {
+            return Err(PyRuntimeError::new_err(format!(
+                "the trial is over after {steps} steps: call reset(seed) to start another"
+            )));
+        }
+        let s = &self.settings;
+        if s.noise.is_active() {
+            s.noise.perturb_outputs(&mut outputs, &mut flight.noise);
+        }
+        for u in &mut outputs {
+            *u = clamp_unit(*u);
+        }
+        let (state, body) = self
+            .physics
+            .with(|engine| engine.step(&outputs).map(|()| (engine.planar_state(), engine.state())))?
+            .map_err(errors::simulation)?;
+        let previous_omega = flight.state.omega;
+        flight.state = state;
+        let next = Trial::read(s, &flight.state, flight.target, &mut flight.noise);
+        let points = score(
+            s.step(),
+            &next,
+            &flight.reading,
+            flight.state.position,
+            flight.state.omega,
+            previous_omega,
+            flight.target,
+        );
+        flight.reading = next;
+        flight.points += points;
+        flight.steps += 1;
+        flight.states.push(body);
+        flight.outputs.push(outputs);
+        Ok((flight.reading.inputs, 100.0 * points / maximum))
+    }
+
+    /// The last observation (the network's inputs now).
+    pub fn observation(&self) -> PyResult<[f64; INPUT_COUNT]> {
+        Ok(self.flight.as_ref().ok_or_else(not_started)?.reading.inputs)
+    }
+
+    /// Whether the trial has flown all its steps.
+    pub fn is_over(&self) -> bool {
+        self.flight.as_ref().is_some_and(|f| f.steps >= self.settings.steps)
+    }
+
+    /// The fitness so far, in % of the task's maximum.
+    pub fn fitness_so_far(&self) -> f64 {
+        self.flight.as_ref().map_or(0.0, |f| 100.0 * f.points / self.maximum)
+    }
+
+    /// The body's state: x, y, heading, vx, vy, omega.
+    pub fn body_state(&self) -> PyResult<[f64; 6]> {
+        let s = &self.flight.as_ref().ok_or_else(not_started)?.state;
+        Ok([
+            s.position[0],
+            s.position[1],
+            s.heading(),
+            s.velocity[0],
+            s.velocity[1],
+            s.omega,
+        ])
+    }
+
     /// What the controller reads of the state now.
     fn read(
         settings: &PsaSettings,
@@ -94,7 +194,7 @@ fn not_started() -> PyErr {
 impl Trial {
     #[new]
     #[pyo3(signature = (task, config=None, *, preset="baseline", backend=None, random_init=None))]
-    fn new(
+    pub(crate) fn new(
         task: &Bound<'_, PyAny>,
         config: Option<&Bound<'_, PyAny>>,
         preset: &str,
@@ -122,28 +222,7 @@ impl Trial {
     /// random initialisation, and the noise are drawn from it); returns
     /// the first observation, the network's 7 inputs.
     fn reset<'py>(&mut self, py: Python<'py>, seed: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let seed = args::seed(seed, "seed")?;
-        let s = &self.settings;
-        let mut rng = stream(seed, &[REPLAY_STREAM]);
-        let (start, target) = s.tasks.start_and_target(self.task, s.random_init, &mut rng);
-        let (state, body) = self
-            .physics
-            .with(|engine| engine.reset(&start).map(|()| (engine.planar_state(), engine.state())))?
-            .map_err(errors::simulation)?;
-        let mut noise = NoiseSource::new(s.noise.draw_seed(&mut rng));
-        let target = [target.x, target.y, target.heading];
-        let reading = Trial::read(s, &state, target, &mut noise);
-        let inputs = reading.inputs;
-        self.flight = Some(Flight {
-            target,
-            noise,
-            state,
-            reading,
-            points: 0.0,
-            steps: 0,
-            states: vec![body],
-            outputs: Vec::new(),
-        });
+        let inputs = self.start(args::seed(seed, "seed")?)?;
         Ok(PyArray1::from_slice(py, &inputs))
     }
 
@@ -166,58 +245,17 @@ impl Trial {
                 commands.len()
             )));
         }
-        if let Some(bad) = commands.iter().find(|u| !u.is_finite()) {
-            return Err(PyValueError::new_err(format!("thrust must be finite, got {bad}")));
-        }
-        let steps = self.settings.steps;
-        let maximum = self.maximum;
-        let flight = self.flight.as_mut().ok_or_else(not_started)?;
-        if flight.steps >= steps {
-            return Err(PyRuntimeError::new_err(format!(
-                "the trial is over after {steps} steps: call reset(seed) to start another"
-            )));
-        }
         let mut outputs = [0.0; THRUSTER_COUNT];
         outputs.copy_from_slice(&commands);
-        let s = &self.settings;
-        if s.noise.is_active() {
-            s.noise.perturb_outputs(&mut outputs, &mut flight.noise);
-        }
-        for u in &mut outputs {
-            *u = clamp_unit(*u);
-        }
-        let (state, body) = self
-            .physics
-            .with(|engine| engine.step(&outputs).map(|()| (engine.planar_state(), engine.state())))?
-            .map_err(errors::simulation)?;
-        let previous_omega = flight.state.omega;
-        flight.state = state;
-        let next = Trial::read(s, &flight.state, flight.target, &mut flight.noise);
-        let points = score(
-            s.step(),
-            &next,
-            &flight.reading,
-            flight.state.position,
-            flight.state.omega,
-            previous_omega,
-            flight.target,
-        );
-        flight.reading = next;
-        flight.points += points;
-        flight.steps += 1;
-        flight.states.push(body);
-        flight.outputs.push(outputs);
-        Ok((
-            PyArray1::from_slice(py, &flight.reading.inputs),
-            100.0 * points / maximum,
-        ))
+        let (inputs, reward) = self.advance(outputs)?;
+        Ok((PyArray1::from_slice(py, &inputs), reward))
     }
 
     /// The trial's fitness so far, in % of the task's theoretical
     /// maximum: after the last step, the bits `evaluate` gives (one trial).
     #[getter]
     fn fitness(&self) -> f64 {
-        self.flight.as_ref().map_or(0.0, |f| 100.0 * f.points / self.maximum)
+        self.fitness_so_far()
     }
 
     /// Steps flown in this trial.
@@ -241,23 +279,14 @@ impl Trial {
     /// Whether the trial has flown all its steps.
     #[getter]
     fn done(&self) -> bool {
-        self.flight.as_ref().is_some_and(|f| f.steps >= self.settings.steps)
+        self.is_over()
     }
 
     /// The body's state: x, y (m, world frame), heading (rad), vx, vy
     /// (m/s), omega (rad/s).
     #[getter]
     fn state(&self) -> PyResult<[f64; 6]> {
-        let f = self.flight.as_ref().ok_or_else(not_started)?;
-        let s = &f.state;
-        Ok([
-            s.position[0],
-            s.position[1],
-            s.heading(),
-            s.velocity[0],
-            s.velocity[1],
-            s.omega,
-        ])
+        self.body_state()
     }
 
     /// The target: x, y (m), heading (rad).

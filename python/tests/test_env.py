@@ -140,3 +140,35 @@ def test_an_environment_steps_on_its_own_thread_and_another_thread_gets_a_runtim
     here = episode()
     there = in_thread(episode)
     assert there == {"value": here}
+
+
+@pytest.mark.parametrize(
+    ("task", "problem"),
+    [(1, {"steps": 40}), (3, {"steps": 30, "random_init": True, "noise": {"input_sd": 0.05, "output_sd": 0.05}})],
+)
+def test_the_native_vector_env_flies_what_sync_vector_env_flies_bit_for_bit(task, problem):
+    config = {"problem": problem}
+    native = gymnasium.make_vec(
+        f"psa_esp/Task{task}-v0", num_envs=5, vectorization_mode="vector_entry_point", config=config
+    )
+    sync = gymnasium.vector.SyncVectorEnv([lambda: PsaEnv(task, config) for _ in range(5)])
+    assert native.single_observation_space == sync.single_observation_space
+    rng = np.random.default_rng(task)
+    for first in (11, None):
+        if first is None:
+            # Unseeded resets draw each trial's seed from the sub-environment's generator.
+            native.unwrapped._generators = [np.random.default_rng(100 + i) for i in range(5)]
+            for i, env in enumerate(sync.envs):
+                env._np_random = np.random.default_rng(100 + i)
+        mine, info = native.reset(seed=first)
+        theirs, their_info = sync.reset(seed=first)
+        assert np.array_equal(mine, theirs)
+        assert np.array_equal(info["trial_seed"], their_info["trial_seed"])
+        # Past two trial lengths: the autoreset on the next step included.
+        for _ in range(95):
+            actions = rng.uniform(-0.2, 1.2, size=(5, 4))
+            got = native.step(actions)
+            want = sync.step(actions)
+            for a, b in zip(got[:4], want[:4]):
+                assert np.array_equal(a, b)
+            assert np.array_equal(got[4]["fitness"], want[4]["fitness"])
