@@ -438,7 +438,9 @@ fn every_file_test_and_test_file_contributing_cites_exists() {
         }
         for word in span.split(" --test ").skip(1) {
             let name = word.split_whitespace().next().unwrap_or("");
-            if name != "NAME" && !root().join("tests").join(format!("{name}.rs")).exists() {
+            let tests = root().join("tests");
+            let target = tests.join(format!("{name}.rs")).exists() || tests.join(name).join("main.rs").exists();
+            if name != "NAME" && !target {
                 missing.push(format!("test file tests/{name}.rs"));
             }
         }
