@@ -129,7 +129,7 @@ mod tests {
 
     #[test]
     fn cauchy_draws_are_those_of_the_esp_code() {
-        // Pinned: the draws of today's settings (ESP's 0.3 / 10, the
+        // Pinned: the draws of the default settings (ESP's 0.3 / 10, the
         // hill-climber's 1 / 10) must never change.
         let mut rng = stream(7, &[4, 2]);
         let esp: Vec<u64> = (0..4).map(|_| cauchy(&mut rng, 0.3, 10.0).to_bits()).collect();

@@ -1,6 +1,7 @@
 //! A file that lacks a setting gets the value of the build that wrote it.
 
 use super::*;
+use psa_sim::psa::settings::defaults::Since;
 
 /// `json` as a file of the build `commit` that knew none of the table's
 /// keys: each taken out of its problem.
@@ -215,18 +216,23 @@ fn a_champion_of_each_earlier_model_replays_to_its_recorded_fitness_bit_for_bit_
     }
 }
 
-/// The model before the refit (`configs/positive-heading.toml`): its build
-/// wrote every problem setting and the size of its table of defaults,
-/// four rows short of today's (the refit's task-2 spin, the
-/// hill-climber's two alpha rows and task 2's clockwise start).
-const POSITIVE_HEADING_ROWS: usize = 4;
+/// The size of the table of defaults of the build of the model before the
+/// refit (`configs/positive-heading.toml`): the rows before the refit's
+/// task-2 spin, the first change a build placed by its rows made.
+fn positive_heading_rows() -> usize {
+    CHANGES
+        .iter()
+        .position(|row| row.key == "problem.tasks.task2_spin" && row.since == Since::Commit(""))
+        .expect("the refit's row")
+}
 
 #[test]
 fn a_task_2_champion_of_the_model_before_the_refit_replays_to_its_recorded_fitness_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let (recorded, mut old) = champion_of(dir.path(), "run", "configs/positive-heading.toml", "2");
     assert_eq!(old["problem"]["tasks"]["task2_spin"], 0.75, "the model's own start");
-    old["provenance"]["defaults"] = (psa_sim::psa::settings::defaults::rows() - POSITIVE_HEADING_ROWS).into();
+    // Its build wrote every problem setting and the size of its table.
+    old["provenance"]["defaults"] = positive_heading_rows().into();
     let replayed = replayed(dir.path(), "old", &old);
     assert_eq!(replayed.to_bits(), recorded.to_bits(), "{replayed} against {recorded}");
 }

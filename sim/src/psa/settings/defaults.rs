@@ -1,7 +1,7 @@
 //! When each default changed: one table, so that a file this tool wrote
 //! that lacks a setting (a network file, a run's `config.toml`, written
 //! before the setting existed) gets the value the build that wrote it used,
-//! not today's default.
+//! not the reading build's default.
 //!
 //! A key is a dotted path of a run's configuration (`problem.sensors.heading_wrap`,
 //! `esp.stagnation`); a network file's `problem` is the `problem.` part.
@@ -215,7 +215,7 @@ fn descends(build: &str, prefix: &str) -> bool {
 }
 
 /// The value the build at `placement` used for `key`: `Ok(None)` when the
-/// table has no row for it (its default never changed: today's holds),
+/// table has no row for it (its default never changed: every build's holds),
 /// an error naming the key when the build cannot be placed.
 pub fn value_at(key: &str, placement: &Placement) -> Result<Option<Value>, String> {
     let rows: Vec<usize> = (0..CHANGES.len()).filter(|&i| CHANGES[i].key == key).collect();
