@@ -27,37 +27,33 @@ static NEXT_KEY: AtomicU64 = AtomicU64::new(0);
 pub struct ThreadBound {
     owner: ThreadId,
     key: u64,
-    /// The Python class that holds it, for the error message.
-    holder: &'static str,
 }
 
 impl ThreadBound {
-    /// Puts `engine` in this thread's table, for an object of class `holder`.
-    pub fn new(engine: Box<dyn PhysicsBackend>, holder: &'static str) -> ThreadBound {
+    /// Puts `engine` in this thread's table.
+    pub fn new(engine: Box<dyn PhysicsBackend>) -> ThreadBound {
         let key = NEXT_KEY.fetch_add(1, Ordering::Relaxed);
         ENGINES.with_borrow_mut(|engines| engines.insert(key, engine));
         ThreadBound {
             owner: thread::current().id(),
             key,
-            holder,
         }
     }
 
     /// Runs `f` on the engine; refused on any thread but its own.
     pub fn with<R>(&self, f: impl FnOnce(&mut dyn PhysicsBackend) -> R) -> PyResult<R> {
         if thread::current().id() != self.owner {
-            return Err(PyRuntimeError::new_err(format!(
-                "a {} steps only on the thread that made it (its physics world may be an ODE \
-                 world, which lives on one thread): make one in each thread that steps it",
-                self.holder
-            )));
+            return Err(PyRuntimeError::new_err(
+                "a Trial (and the environment over it) steps only on the thread that made it (its \
+                 physics world may be an ODE world, which lives on one thread): make one in each \
+                 thread that steps it",
+            ));
         }
         ENGINES.with_borrow_mut(|engines| match engines.get_mut(&self.key) {
             Some(engine) => Ok(f(engine.as_mut())),
-            None => Err(PyRuntimeError::new_err(format!(
-                "this {}'s physics engine is gone (its thread's table was dropped)",
-                self.holder
-            ))),
+            None => Err(PyRuntimeError::new_err(
+                "this Trial's physics engine is gone (its thread's table was dropped)",
+            )),
         })
     }
 }

@@ -213,7 +213,7 @@ impl Trial {
             maximum: settings.fitness.maximum(settings.steps),
             settings,
             task,
-            physics: ThreadBound::new(backend, "Trial"),
+            physics: ThreadBound::new(backend),
             flight: None,
         })
     }

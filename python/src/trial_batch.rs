@@ -3,7 +3,7 @@
 //! [`Trial`] and each step its step, so a batch flies exactly what its
 //! single environments fly; only the Python loop around them is gone.
 
-use numpy::ndarray::Array2;
+use numpy::ndarray::{aview1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use psa_sim::psa::{INPUT_COUNT, THRUSTER_COUNT};
 use pyo3::exceptions::PyValueError;
@@ -115,9 +115,7 @@ impl TrialBatch {
                 over[i] = trial.is_over();
                 inputs
             };
-            for (cell, value) in observations.row_mut(i).iter_mut().zip(inputs) {
-                *cell = value;
-            }
+            observations.row_mut(i).assign(&aview1(&inputs));
         }
         Ok((
             observations.into_pyarray(py),
@@ -136,15 +134,11 @@ impl TrialBatch {
     /// `Trial.state`.
     #[getter]
     fn states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let rows = self
-            .trials
-            .iter()
-            .map(Trial::body_state)
-            .collect::<PyResult<Vec<[f64; 6]>>>()?;
-        Ok(PyArray2::from_vec2(
-            py,
-            &rows.iter().map(|r| r.to_vec()).collect::<Vec<_>>(),
-        )?)
+        let mut states = Array2::zeros((self.trials.len(), 6));
+        for (i, trial) in self.trials.iter().enumerate() {
+            states.row_mut(i).assign(&aview1(&trial.body_state()?));
+        }
+        Ok(states.into_pyarray(py))
     }
 
     fn __len__(&self) -> usize {
