@@ -8,6 +8,8 @@ use std::process::Output;
 
 use esp_neuroevolution::network::Network;
 use esp_neuroevolution::rng::stream;
+use psa_experiment::models::EarlierModel;
+use psa_sim::named::Named;
 use psa_sim::physics::BackendKind;
 use psa_sim::psa::{PsaSettings, Task, TrialRunner};
 
@@ -148,8 +150,7 @@ fn the_positive_heading_file_repeats_the_records_of_the_model_before_the_reading
     let dir = tempfile::tempdir().unwrap();
     let frequent = dir.path().join("frequent-bursts.toml");
     let text = std::fs::read_to_string(repo(config)).unwrap();
-    assert!(text.contains("\nstagnation = 50\n"), "{config} pins b = 50");
-    std::fs::write(&frequent, text.replace("\nstagnation = 50\n", "\nstagnation = 5\n")).unwrap();
+    std::fs::write(&frequent, format!("{text}\n[esp]\nstagnation = 5\n")).unwrap();
     for task in ["1", "2", "3"] {
         assert_repeats_one_golden_record(&frequent, "positive-heading", "erase-best", "erase-best-b5", task);
     }
@@ -192,20 +193,20 @@ fn the_noiseless_bias_file_repeats_the_records_of_sweeps_s41_to_s46_byte_for_byt
     // on the six sensed inputs, not on the bias. Evolution under input
     // noise (Table 3's configuration) is the run that reads it.
     let dir = tempfile::tempdir().unwrap();
-    let noisy = |name: &str, text: &str| {
+    let noisy = |name: &str, model: &str| {
         let path = dir.path().join(name);
-        assert!(text.contains("\n[problem]\n") && text.contains("\n[problem.noise]\n"));
-        let text = text
-            .replace("\n[problem]\n", "\n[problem]\ntrials = 3\n")
-            .replace("\n[problem.noise]\n", "\n[problem.noise]\ninput_sd = 0.05\n");
-        std::fs::write(&path, text).unwrap();
+        std::fs::write(
+            &path,
+            format!("{model}[problem]\ntrials = 3\n[problem.noise]\ninput_sd = 0.05\n"),
+        )
+        .unwrap();
         path
     };
     let pinned = noisy(
         "noiseless-bias.toml",
         &std::fs::read_to_string(repo("configs/noiseless-bias.toml")).unwrap(),
     );
-    let defaults = noisy("defaults.toml", "\n[problem]\n\n[problem.noise]\n");
+    let defaults = noisy("defaults.toml", "");
     for task in ["1", "2", "3"] {
         assert_repeats_one_golden_record(&pinned, "noiseless-bias", "baseline", "input-noise", task);
         // Today's defaults put the noise on the bias too: another run.
@@ -231,6 +232,22 @@ fn the_positive_wrap_file_repeats_the_records_of_the_confirmed_grid_byte_for_byt
             "task {task}: the defaults did not move"
         );
     }
+}
+
+#[test]
+fn every_earlier_model_and_the_fits_starting_point_have_golden_records_and_nothing_else_has() {
+    let mut folders: Vec<String> = std::fs::read_dir(repo("tests/golden"))
+        .unwrap()
+        .map(|entry| entry.unwrap().file_name().into_string().unwrap())
+        .collect();
+    folders.sort();
+    let mut models: Vec<String> = EarlierModel::names().iter().map(|name| name.to_string()).collect();
+    models.push("fit-stage1".into());
+    models.sort();
+    assert_eq!(
+        folders, models,
+        "tests/golden/ against the earlier models and configs/fit-stage1.toml"
+    );
 }
 
 /// The `records.csv` of the golden records' run (seed 7, 120 generations,
@@ -267,12 +284,7 @@ fn assert_repeats_the_random_start_records(config: &str, golden: &str) {
     let dir = tempfile::tempdir().unwrap();
     let random_starts = dir.path().join("random-starts.toml");
     let text = std::fs::read_to_string(repo(config)).unwrap();
-    assert!(text.contains("\n[problem]\n"), "{config} has no [problem] table");
-    std::fs::write(
-        &random_starts,
-        text.replace("\n[problem]\n", "\n[problem]\nrandom_init = true\n"),
-    )
-    .unwrap();
+    std::fs::write(&random_starts, format!("{text}\n[problem]\nrandom_init = true\n")).unwrap();
     for task in ["1", "3"] {
         assert_repeats_one_golden_record(&random_starts, golden, "baseline", "random-init", task);
     }

@@ -194,10 +194,11 @@ impl RunConfig {
         RunConfig::base().with_overrides(toml_text)
     }
 
-    /// This configuration with the settings of a TOML document laid over it;
+    /// This configuration with the settings of a TOML document laid over it
+    /// (after the earlier model it names, if any: [`crate::models`]);
     /// unknown keys and out-of-range values are errors naming the key.
     pub fn with_overrides(&self, toml_text: &str) -> Result<RunConfig> {
-        let overrides: toml::Table = toml::from_str(toml_text)?;
+        let overrides = crate::models::configuration_table(toml_text)?;
         let mut table = toml::Table::try_from(self)?;
         merge(&mut table, overrides);
         let config: RunConfig = table.try_into()?;
@@ -213,10 +214,11 @@ impl RunConfig {
     }
 
     /// The dotted keys (`problem.noise.input_sd`) a configuration file
-    /// sets, whatever their values.
+    /// sets, whatever their values (those of the model it names included).
     pub fn keys_set_by(path: &Path) -> Result<Vec<String>> {
         let text = psa_sim::io::read_input(path, "configuration")?;
-        let table: toml::Table = toml::from_str(&text).with_context(|| format!("configuration {}", path.display()))?;
+        let table =
+            crate::models::configuration_table(&text).with_context(|| format!("configuration {}", path.display()))?;
         let mut leaves = Vec::new();
         crate::grid::leaves(&table, "", &mut leaves);
         Ok(leaves.into_iter().map(|(key, _)| key).collect())

@@ -12,11 +12,13 @@
 //! batch jobs); [`results`], what a run and a grid leave (the results
 //! model, `runs.csv`, the column tables, statistics); [`champion`], the
 //! tests of a run's champion (robustness, the ODE check); [`report`] and
-//! [`plots`]; and at the root the configuration and the single run.
+//! [`plots`]; and at the root the configuration, the earlier models
+//! ([`models`]) and the single run.
 
 pub mod champion;
 mod config;
 pub mod grid;
+pub mod models;
 pub mod plots;
 pub mod report;
 pub mod results;

@@ -1,7 +1,10 @@
 //! A file that lacks a setting gets the value of the build that wrote it.
 
 use super::*;
+use psa_experiment::models::EarlierModel;
+use psa_sim::named::Named;
 use psa_sim::psa::settings::defaults::Since;
+use strum::VariantArray;
 
 /// `json` as a file of the build `commit` that knew none of the table's
 /// keys: each taken out of its problem.
@@ -54,110 +57,33 @@ fn a_network_file_from_before_a_setting_loads_with_the_value_its_build_used() {
     assert_eq!(load_json(dir.path(), &new).unwrap(), PsaSettings::default());
 }
 
-/// Where an earlier model stands in the table of defaults.
-enum Build {
-    /// The defaults of the builds before this commit (its parent's).
-    Before(&'static str),
-    /// The defaults of the builds before the table's row that set `key` to
-    /// `value` (rows added after the table came in name no commit).
-    BeforeRow(&'static str, &'static str),
-}
-
-impl Build {
-    fn placement(&self) -> Placement {
-        match *self {
-            Build::Before(commit) => Placement::of(None, Some(&parent_of(commit))),
-            Build::BeforeRow(key, value) => {
-                let row = CHANGES
-                    .iter()
-                    .rposition(|row| row.key == key && row.value == value)
-                    .unwrap_or_else(|| panic!("no row sets {key} to {value}"));
-                Placement::Rows(row)
-            }
-        }
-    }
-}
-
-/// Every earlier model under `configs/` and the builds that had it as
-/// their defaults.
-const MODELS: [(&str, Build); 9] = [
-    ("previous-defaults.toml", Build::Before("95ee59b")),
-    ("fitted-incremental.toml", Build::Before("d497677")),
-    ("scored-on-original.toml", Build::Before("a1ccaad")),
-    ("symmetric-heading.toml", Build::Before("a70d696")),
-    ("positive-heading.toml", Build::Before("8cf59c9")),
-    (
-        "task2-towards-target.toml",
-        Build::BeforeRow("problem.tasks.task2_spin", "-1.5"),
-    ),
-    (
-        "clockwise-start.toml",
-        Build::BeforeRow("problem.tasks.task2_spin", "-0.75"),
-    ),
-    ("noiseless-bias.toml", Build::BeforeRow("problem.noise.on_bias", "true")),
-    (
-        "positive-wrap.toml",
-        Build::BeforeRow("problem.sensors.heading_wrap", r#""symmetric""#),
-    ),
-];
-
-/// The files under `configs/` that are no build's defaults: the fit's
+/// The files under `configs/` that are no earlier build's model: the fit's
 /// starting point (the previous defaults with the paper's stagnation
 /// rule) and the paper's words.
 const NOT_MODELS: [&str; 2] = ["fit-stage1.toml", "text.toml"];
 
-/// A table value (TOML) and the defaults table's (JSON) are the same value.
-fn same_value(file: &toml::Value, table: &serde_json::Value) -> bool {
-    let file = serde_json::to_value(file).unwrap();
-    match (file.as_f64(), table.as_f64()) {
-        (Some(a), Some(b)) => a == b,
-        _ => file == *table,
-    }
-}
-
 #[test]
-fn the_table_of_defaults_gives_each_earlier_model_of_configs_exactly_its_values() {
-    // Every file under configs/ is listed, as a build's model or as none.
+fn each_earlier_model_has_a_file_under_configs_that_names_it_and_nothing_else() {
     let mut files: Vec<String> = std::fs::read_dir(repo("configs"))
         .unwrap()
         .map(|entry| entry.unwrap().file_name().into_string().unwrap())
         .collect();
     files.sort();
-    let mut listed: Vec<String> = MODELS.iter().map(|(file, _)| file.to_string()).collect();
+    let mut listed: Vec<String> = EarlierModel::names()
+        .iter()
+        .map(|name| format!("{name}.toml"))
+        .collect();
     listed.extend(NOT_MODELS.iter().map(|file| file.to_string()));
     listed.sort();
-    assert_eq!(files, listed, "configs/ against the lists of this test");
-
-    let today = Placement::Rows(CHANGES.len());
-    for (file, build) in &MODELS {
-        let text = std::fs::read_to_string(repo("configs").join(file)).unwrap();
+    assert_eq!(files, listed, "configs/ against the earlier models and the two others");
+    for model in EarlierModel::VARIANTS {
+        let text = std::fs::read_to_string(repo("configs").join(format!("{model}.toml"))).unwrap();
         let table: toml::Table = toml::from_str(&text).unwrap();
-        let placement = build.placement();
-        let keys: std::collections::BTreeSet<&str> = CHANGES.iter().map(|row| row.key).collect();
-        for key in keys {
-            let mut at = Some(&table);
-            let mut parts: Vec<&str> = key.split('.').collect();
-            let last = parts.pop().unwrap();
-            for part in parts {
-                at = at.and_then(|t| t.get(part)).and_then(|v| v.as_table());
-            }
-            let then = value_at(key, &placement).unwrap().unwrap();
-            match at.and_then(|t| t.get(last)) {
-                // The file sets the key: to the model's value.
-                Some(value) => assert!(
-                    same_value(value, &then),
-                    "configs/{file}: {key} = {value} there, {then} in the table"
-                ),
-                // It leaves it to the defaults: which must be the model's.
-                None => {
-                    let now = value_at(key, &today).unwrap().unwrap();
-                    assert_eq!(
-                        now, then,
-                        "configs/{file} does not set {key}, whose default has changed since"
-                    );
-                }
-            }
-        }
+        let expected: toml::Table = toml::from_str(&format!("model = \"{model}\"")).unwrap();
+        assert_eq!(
+            table, expected,
+            "configs/{model}.toml sets its model's name and nothing else"
+        );
     }
 }
 
@@ -200,13 +126,15 @@ fn a_champion_of_each_earlier_model_replays_to_its_recorded_fitness_bit_for_bit_
     let dir = tempfile::tempdir().unwrap();
     // The models of the builds before the table (whose files name their
     // commit, not the table's rows).
-    for (i, (file, build)) in MODELS.iter().enumerate() {
-        let Build::Before(changed) = build else { continue };
-        let config = format!("configs/{file}");
+    for (i, model) in EarlierModel::VARIANTS.iter().enumerate() {
+        let Placement::Commit(build) = model.placement() else {
+            continue;
+        };
+        let config = format!("configs/{model}.toml");
         let (recorded, mut old) = champion_of(dir.path(), &format!("run{i}"), &config, "1");
         // The champion as the build of its model would have written it:
         // none of the settings that build did not have yet.
-        as_file_of(&mut old, &parent_of(changed));
+        as_file_of(&mut old, &build);
         let replayed = replayed(dir.path(), &format!("old{i}"), &old);
         assert_eq!(
             replayed.to_bits(),
@@ -235,4 +163,38 @@ fn a_task_2_champion_of_the_model_before_the_refit_replays_to_its_recorded_fitne
     old["provenance"]["defaults"] = positive_heading_rows().into();
     let replayed = replayed(dir.path(), "old", &old);
     assert_eq!(replayed.to_bits(), recorded.to_bits(), "{replayed} against {recorded}");
+}
+
+#[test]
+fn a_configuration_naming_an_unknown_model_is_refused_listing_the_models() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("model.toml");
+    std::fs::write(&config, "model = \"positive\"\n").unwrap();
+    let out = dir.path().join("run");
+    let args = [
+        "evolve",
+        "--task",
+        "1",
+        "--generations",
+        "1",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    refused(
+        &psa_esp(&args),
+        &["model.toml", "\"positive\"", "positive-wrap", "previous-defaults"],
+    );
+    assert!(!out.exists(), "nothing written");
+    // A known one flies that model, under the file's own settings.
+    std::fs::write(&config, "model = \"positive-wrap\"\n[esp]\nstagnation = 7\n").unwrap();
+    ok(&psa_esp(&args));
+    let recorded: toml::Table = toml::from_str(&std::fs::read_to_string(out.join("config.toml")).unwrap()).unwrap();
+    assert_eq!(
+        recorded["problem"]["sensors"]["heading_wrap"].as_str(),
+        Some("positive")
+    );
+    assert_eq!(recorded["esp"]["stagnation"].as_integer(), Some(7));
+    assert!(!recorded.contains_key("model"), "the run records the model resolved");
 }

@@ -26,7 +26,7 @@ use psa_experiment::grid::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_
 use psa_experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
 use psa_experiment::RunFiles;
 use psa_sim::physics::{BackendKind, StartQuaternion};
-use psa_sim::psa::settings::defaults::{value_at, Placement, BUILDS, CHANGES};
+use psa_sim::psa::settings::defaults::{Placement, BUILDS, CHANGES};
 use psa_sim::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};
 
 use common::psa_esp;

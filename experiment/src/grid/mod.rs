@@ -33,6 +33,7 @@ use strum::VariantArray;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
+use crate::models::configuration_table;
 use crate::{EvolveOutcome, GridConfig, RunConfig, RunFiles};
 use psa_sim::named::Named;
 use psa_sim::physics::BackendKind;
@@ -245,7 +246,7 @@ impl GridSpec {
         self.validate()?;
         for (text, what) in [(&self.overrides, "configuration"), (&self.rescoring, "rescoring")] {
             let Some(text) = text else { continue };
-            let table: toml::Table = toml::from_str(text).with_context(|| format!("the grid's {what}"))?;
+            let table = configuration_table(text).with_context(|| format!("the grid's {what}"))?;
             for (key, option) in GRID_KEYS {
                 let mut parts = key.split('.');
                 let (section, name) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
@@ -365,15 +366,9 @@ impl GridSpec {
         placement: &psa_sim::psa::settings::defaults::Placement,
     ) -> Result<RunConfig> {
         let mut table = toml::Table::try_from(RunConfig::default())?;
-        for row in psa_sim::psa::settings::defaults::CHANGES {
-            let value = psa_sim::psa::settings::defaults::value_at(row.key, placement).map_err(anyhow::Error::msg)?;
-            if let Some(value) = value {
-                let value: toml::Value = serde_json::from_value(value)?;
-                set_leaf(&mut table, row.key, value);
-            }
-        }
+        crate::config::merge(&mut table, crate::models::defaults_at(placement)?);
         if let Some(text) = &self.overrides {
-            let overrides: toml::Table = toml::from_str(text).context("the grid's configuration overrides")?;
+            let overrides = configuration_table(text).context("the grid's configuration overrides")?;
             crate::config::merge(&mut table, overrides);
         }
         let base: RunConfig = table.try_into()?;
@@ -393,7 +388,7 @@ impl GridSpec {
             Some(text) => {
                 let mut set = Vec::new();
                 leaves(
-                    &toml::from_str(text).context("the grid's configuration overrides")?,
+                    &configuration_table(text).context("the grid's configuration overrides")?,
                     "",
                     &mut set,
                 );
@@ -647,25 +642,6 @@ fn folder_build(folder: &Path) -> String {
         ),
         None => "the run is unfinished: no run.json names its build".into(),
     }
-}
-
-/// Sets the dotted `key` of `table` to `value`, making the tables on the way.
-fn set_leaf(table: &mut toml::Table, key: &str, value: toml::Value) {
-    let mut parts: Vec<&str> = key.split('.').collect();
-    let Some(last) = parts.pop() else {
-        return;
-    };
-    let mut at = table;
-    for part in parts {
-        let entry = at
-            .entry(part.to_string())
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        let Some(inner) = entry.as_table_mut() else {
-            return;
-        };
-        at = inner;
-    }
-    at.insert(last.to_string(), value);
 }
 
 /// Every leaf setting of a TOML table, as dotted keys with their values.

@@ -13,6 +13,7 @@ use crate::grid::replicate::prepare;
 use crate::grid::runner::{mark_finished, run_seed, score_champion};
 use crate::grid::shard::Shard;
 use crate::grid::{judge_run, run_dir, GridSpec, Judge, RunKey, RunStatus};
+use crate::models::configuration_table;
 use crate::RunFiles;
 use psa_sim::evaluator::EvalPath;
 
@@ -39,10 +40,10 @@ pub struct RescoreSummary {
 /// check, and `trials` robustness trials when given.
 pub fn rescored_spec(source: &GridSpec, overlay: &str, trials: Option<usize>) -> Result<GridSpec> {
     let mut table: toml::Table = match &source.rescoring {
-        Some(text) => toml::from_str(text).context("the source grid's rescoring")?,
+        Some(text) => configuration_table(text).context("the source grid's rescoring")?,
         None => toml::Table::new(),
     };
-    let added: toml::Table = toml::from_str(overlay).context("the rescoring settings")?;
+    let added = configuration_table(overlay).context("the rescoring settings")?;
     crate::config::merge(&mut table, added);
     let spec = GridSpec {
         rescoring: Some(toml::to_string(&table)?),
@@ -73,7 +74,7 @@ pub fn rescored_spec(source: &GridSpec, overlay: &str, trials: Option<usize>) ->
 /// own configuration: a grid of an earlier build flew that build's
 /// defaults), else on the grid's definition.
 pub fn check_rescoring_acts(dir: &Path, source: &GridSpec, overlay: &str) -> Result<()> {
-    let added: toml::Table = toml::from_str(overlay).context("the rescoring settings")?;
+    let added = configuration_table(overlay).context("the rescoring settings")?;
     let mut bases = Vec::new();
     for &config in &source.configs {
         let finished = source.runs().into_iter().find(|key| {

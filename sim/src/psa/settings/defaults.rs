@@ -166,6 +166,22 @@ impl Placement {
         }
     }
 
+    /// The builds just before `commit` (a prefix of a commit of [`BUILDS`]):
+    /// its first parent. `None` when [`BUILDS`] has no such commit.
+    pub fn before_commit(commit: &str) -> Option<Placement> {
+        let line = BUILDS.lines().find(|line| line.starts_with(commit))?;
+        Some(Placement::Commit(line.split(' ').nth(1)?.to_string()))
+    }
+
+    /// The builds just before the row that set `key` to `value` (JSON), the
+    /// last such row: a table of that many rows. `None` when no row does.
+    pub fn before_row(key: &str, value: &str) -> Option<Placement> {
+        CHANGES
+            .iter()
+            .rposition(|row| row.key == key && row.value == value)
+            .map(Placement::Rows)
+    }
+
     /// The placement of a file whose provenance is the JSON object `provenance`.
     /// A file without one says so: its provenance is missing.
     pub fn of_json(provenance: Option<&serde_json::Map<String, Value>>) -> Placement {
