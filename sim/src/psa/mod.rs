@@ -7,6 +7,7 @@ pub mod body;
 pub mod cuda;
 pub mod error;
 pub mod fitness;
+mod flight;
 pub mod network_file;
 pub mod ode_lockstep;
 pub mod sensors;

@@ -2,10 +2,9 @@
 //! together, one body per network in one ODE world ([`OdeFleet`]), one
 //! `dWorldStep` per step for all of them.
 //!
-//! Every network runs the arithmetic of the scalar path ([`TrialRunner`]
-//! on `ode`), operation for operation: the same sensors, noise, network,
-//! clamping and fitness functions, and ODE bodies built, pushed and read by
-//! the same functions; each body is an island of its own, which ODE steps
+//! Every network runs the scalar path's trial loop ([`TrialRunner`] on
+//! `ode`; both fly `fly_steps` of [`super::flight`]), operation for
+//! operation, and ODE bodies built, pushed and read by the same functions; each body is an island of its own, which ODE steps
 //! from that body's state and forces alone. Each network draws its random
 //! starts and noise seeds from its own stream in the scalar path's order
 //! (trial by trial: start, then noise seed). So its fitness is bit-identical
@@ -23,12 +22,11 @@ use std::ops::Range;
 
 use multiversion::multiversion;
 
-use super::step::{score, sense, Reading};
+use super::flight::{fly_steps, Lane};
 use super::trial::{mean_of_trials, TrialRunner};
-use super::{PsaError, PsaSettings};
-use super::{Target, Task, INPUT_COUNT, THRUSTER_COUNT};
-use crate::numeric::{clamp_unit, NoiseSource};
-use crate::physics::{BackendKind, OdeFleet, PlanarState};
+use super::{PsaError, PsaSettings, Task};
+use crate::numeric::NoiseSource;
+use crate::physics::{BackendKind, OdeFleet};
 use esp_neuroevolution::network::{Network, NetworkSet};
 use esp_neuroevolution::rng::Stream;
 
@@ -108,7 +106,7 @@ impl OdeLockstepRunner {
                 let (start, target) = s.tasks.start_and_target(self.task, s.random_init, rng);
                 self.fleet.reset(l, &start)?;
                 let noise = NoiseSource::new(s.noise.draw_seed(rng));
-                lanes.push(Lane::new(network, target, noise, self.fleet.planar_state(l)));
+                lanes.push(Lane::new(network, &target, noise, self.fleet.planar_state(l)));
             }
             let fly = if s.noise.is_active() { fly_noisy } else { fly_clean };
             fly(s, &mut self.fleet, &mut lanes)?;
@@ -120,104 +118,20 @@ impl OdeLockstepRunner {
     }
 }
 
-/// One network's trial in a lockstep flight: what the scalar path's
-/// `fly_steps` in [`super::trial`] keeps between steps.
-struct Lane<'n> {
-    network: &'n Network,
-    target: [f64; 3],
-    noise: NoiseSource<u64>,
-    state: PlanarState<f64>,
-    /// What the controller read last (set when the flight starts).
-    reading: Reading<f64>,
-    points: f64,
-}
-
-impl<'n> Lane<'n> {
-    /// A lane at the start of its trial, its body in `state`.
-    fn new(network: &'n Network, target: Target, noise: NoiseSource<u64>, state: PlanarState<f64>) -> Lane<'n> {
-        Lane {
-            network,
-            target: [target.x, target.y, target.heading],
-            noise,
-            state,
-            reading: Reading {
-                inputs: [0.0; INPUT_COUNT],
-                heading_error: 0.0,
-            },
-            points: 0.0,
-        }
-    }
-
-    /// What the controller reads of the lane's state now.
-    #[inline(always)]
-    fn read<const NOISY: bool>(&mut self, s: &PsaSettings) -> Reading<f64> {
-        let state = &self.state;
-        sense::<f64, NOISY>(
-            s.step(),
-            state.position,
-            state.velocity,
-            state.heading(),
-            state.omega,
-            self.target,
-            &mut self.noise,
-        )
-    }
-}
-
 /// Declares `$name`: one trial of every body of the fleet from its current
 /// state, body `l` flown as `lanes[l]` says, with noise or without
-/// ([`fly_steps`]); the points add up in the lanes. Compiled as the scalar
-/// path's trial loop is (see `trial_loop` in [`super::trial`]): apart with
-/// and without noise, and with AVX2 and FMA where the CPU has them (the
-/// same results either way).
+/// ([`fly_steps`], the scalar path's loop too); the points add up in the
+/// lanes. Compiled as the scalar path's trial loop is (see `trial_loop` in
+/// [`super::trial`]): apart with and without noise, and with AVX2 and FMA
+/// where the CPU has them (the same results either way).
 macro_rules! lockstep_loop {
     ($name:ident, $noisy:expr, $avx512:tt, $avx2:tt) => {
         #[multiversion(targets($avx2))]
         fn $name<'n>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &mut [Lane<'n>]) -> Result<(), PsaError> {
-            fly_steps::<$noisy>(s, fleet, lanes)
+            fly_steps::<$noisy, _>(s, fleet, lanes, None)
         }
     };
 }
 
 crate::with_simd_targets!(lockstep_loop!(fly_clean, false,));
 crate::with_simd_targets!(lockstep_loop!(fly_noisy, true,));
-
-/// The loop of `fly_clean` and `fly_noisy`: per lane, the steps of the
-/// scalar path's `fly_steps` in [`super::trial`], with one fleet step for
-/// every body in place of each body's own.
-#[inline(always)]
-fn fly_steps<const NOISY: bool>(s: &PsaSettings, fleet: &mut OdeFleet, lanes: &mut [Lane<'_>]) -> Result<(), PsaError> {
-    let mut outputs = vec![[0.0; THRUSTER_COUNT]; lanes.len()];
-    for lane in lanes.iter_mut() {
-        lane.reading = lane.read::<NOISY>(s);
-    }
-    for _ in 0..s.steps {
-        for (lane, out) in lanes.iter_mut().zip(&mut outputs) {
-            lane.network.activate_with(s.exponential, &lane.reading.inputs, out);
-            if NOISY {
-                s.noise.perturb_outputs(out, &mut lane.noise);
-            }
-            for u in out.iter_mut() {
-                *u = clamp_unit(*u);
-            }
-        }
-        fleet.step(&outputs)?;
-        for (l, lane) in lanes.iter_mut().enumerate() {
-            let previous_omega = lane.state.omega;
-            lane.state = fleet.planar_state(l);
-            let next = lane.read::<NOISY>(s);
-            let state = &lane.state;
-            lane.points += score(
-                s.step(),
-                &next,
-                &lane.reading,
-                state.position,
-                state.omega,
-                previous_omega,
-                lane.target,
-            );
-            lane.reading = next;
-        }
-    }
-    Ok(())
-}

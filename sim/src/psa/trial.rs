@@ -4,12 +4,12 @@
 use multiversion::multiversion;
 
 use super::error::PsaError;
+use super::flight::{fly_steps, Lane};
 use super::sensors::INPUT_COUNT;
 use super::settings::PsaSettings;
-use super::step::{score, sense};
 use super::task::{Target, Task};
 use super::THRUSTER_COUNT;
-use crate::numeric::{clamp_unit, NoiseSource};
+use crate::numeric::NoiseSource;
 use crate::physics::{create_backend, BodyState, PhysicsBackend};
 use esp_neuroevolution::network::Network;
 use esp_neuroevolution::rng::Stream;
@@ -98,9 +98,11 @@ impl TrialRunner {
             };
             r.states.push(start);
         }
-        let mut noise = NoiseSource::new(s.noise.draw_seed(rng));
+        let noise = NoiseSource::new(s.noise.draw_seed(rng));
+        let mut lanes = [Lane::new(network, &target, noise, self.backend.planar_state())];
         let fly = if s.noise.is_active() { fly_noisy } else { fly_clean };
-        fly(s, self.backend.as_mut(), network, &target, &mut noise, record)
+        fly(s, self.backend.as_mut(), &mut lanes, record)?;
+        Ok(lanes[0].points)
     }
 
     /// The fitness of every trial, in % of the theoretical maximum.
@@ -119,8 +121,9 @@ impl TrialRunner {
 }
 
 /// Declares `$name`: the steps of one trial from the backend's current
-/// state, with noise or without ([`fly_steps`]); it returns the points and
-/// fills `record` (already holding the start) when given.
+/// state ([`fly_steps`], the lockstep path's too), with noise or without;
+/// the points add up in the lane, and `record` (already holding the start)
+/// is filled when given.
 ///
 /// The loop is compiled apart with and without noise, so that the noise code
 /// costs noiseless trials nothing, and each of those twice, picked at run
@@ -131,79 +134,19 @@ impl TrialRunner {
 macro_rules! trial_loop {
     ($name:ident, $noisy:expr, $avx512:tt, $avx2:tt) => {
         #[multiversion(targets($avx2))]
-        fn $name(
+        fn $name<'n>(
             s: &PsaSettings,
             backend: &mut dyn PhysicsBackend,
-            network: &Network,
-            target: &Target,
-            noise: &mut NoiseSource<u64>,
+            lanes: &mut [Lane<'n>; 1],
             record: Option<&mut TrialRecord>,
-        ) -> Result<f64, PsaError> {
-            fly_steps::<$noisy>(s, backend, network, target, noise, record)
+        ) -> Result<(), PsaError> {
+            fly_steps::<$noisy, _>(s, backend, lanes, record)
         }
     };
 }
 
 crate::with_simd_targets!(trial_loop!(fly_clean, false,));
 crate::with_simd_targets!(trial_loop!(fly_noisy, true,));
-
-/// The loop of `fly_clean` and `fly_noisy`, with noise if `NOISY`.
-#[inline(always)]
-fn fly_steps<const NOISY: bool>(
-    s: &PsaSettings,
-    backend: &mut dyn PhysicsBackend,
-    network: &Network,
-    target: &Target,
-    noise: &mut NoiseSource<u64>,
-    mut record: Option<&mut TrialRecord>,
-) -> Result<f64, PsaError> {
-    let mut outputs = [0.0; THRUSTER_COUNT];
-    let mut state = backend.planar_state();
-    let target = [target.x, target.y, target.heading];
-    let read = |state: &crate::physics::PlanarState<f64>, noise: &mut NoiseSource<u64>| {
-        sense::<f64, NOISY>(
-            s.step(),
-            state.position,
-            state.velocity,
-            state.heading(),
-            state.omega,
-            target,
-            noise,
-        )
-    };
-    let mut reading = read(&state, noise);
-    let mut points = 0.0;
-    for _ in 0..s.steps {
-        network.activate_with(s.exponential, &reading.inputs, &mut outputs);
-        if NOISY {
-            s.noise.perturb_outputs(&mut outputs, noise);
-        }
-        for u in &mut outputs {
-            *u = clamp_unit(*u);
-        }
-        backend.step(&outputs)?;
-        let previous_omega = state.omega;
-        state = backend.planar_state();
-        let next = read(&state, noise);
-        let step_points = score(
-            s.step(),
-            &next,
-            &reading,
-            state.position,
-            state.omega,
-            previous_omega,
-            target,
-        );
-        reading = next;
-        points += step_points;
-        if let Some(r) = record.as_deref_mut() {
-            r.states.push(state.to_body_state());
-            r.outputs.push(outputs);
-            r.points.push(step_points);
-        }
-    }
-    Ok(points)
-}
 
 /// An evaluation's fitness from its trials' fitness values: their mean,
 /// summed in trial order.
