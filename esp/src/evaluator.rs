@@ -174,11 +174,29 @@ pub fn evaluate_all<E: Evaluator, S: NetworkSet + ?Sized>(
     seed: u64,
     key: &[u64],
 ) -> Result<Vec<f64>, RunError> {
+    evaluate_range(evaluator, networks, seed, key, 0..networks.len())
+}
+
+/// [`evaluate_all`] for networks `range` of `networks` only, each with the
+/// stream it has there: the same bits, so that a caller can evaluate a
+/// large set in pieces (and check for an interruption between them). An
+/// error names the network by its index in `networks`.
+///
+/// # Panics
+/// If `range` reaches past the networks.
+pub fn evaluate_range<E: Evaluator, S: NetworkSet + ?Sized>(
+    evaluator: &E,
+    networks: &S,
+    seed: u64,
+    key: &[u64],
+    range: Range<usize>,
+) -> Result<Vec<f64>, RunError> {
+    assert!(range.end <= networks.len(), "networks {range:?} of {}", networks.len());
     let streams = StreamFamily::new(seed, key);
     if evaluator.batch_size() > 1 {
-        return evaluate_batches(evaluator, networks, &streams);
+        return evaluate_batches(evaluator, networks, range, &streams);
     }
-    (0..networks.len())
+    range
         .into_par_iter()
         .map_init(
             || evaluator.worker().map_err(|e| format!("{e:#}")),
@@ -234,8 +252,8 @@ pub(crate) fn batch_ranges(networks: usize, size: usize, narrowest: usize, threa
     ranges
 }
 
-/// [`evaluate_all`] for a batched evaluator: the batches of
-/// [`batch_ranges`] on the current rayon pool, each taken by whichever
+/// [`evaluate_range`] for a batched evaluator: the batches of
+/// [`batch_ranges`] over `range` on the current rayon pool, each taken by whichever
 /// thread is free (rayon's work stealing, so a thread slowed down on a
 /// shared host does less of the work), a worker made for each of rayon's
 /// tasks. Waiting threads sleep as rayon puts them to sleep; none spins.
@@ -243,14 +261,19 @@ pub(crate) fn batch_ranges(networks: usize, size: usize, narrowest: usize, threa
 fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
     evaluator: &E,
     networks: &S,
+    range: Range<usize>,
     streams: &StreamFamily,
 ) -> Result<Vec<f64>, RunError> {
-    let ranges = batch_ranges(
-        networks.len(),
+    let offset = range.start;
+    let ranges: Vec<Range<usize>> = batch_ranges(
+        range.len(),
         evaluator.batch_size(),
         evaluator.narrowest_batch(),
         rayon::current_num_threads(),
-    );
+    )
+    .into_iter()
+    .map(|batch| batch.start + offset..batch.end + offset)
+    .collect();
     let pieces: Vec<Result<Vec<f64>, RunError>> = ranges
         .into_par_iter()
         .with_max_len(1)
@@ -268,7 +291,7 @@ fn evaluate_batches<E: Evaluator, S: NetworkSet + ?Sized>(
             },
         )
         .collect();
-    let mut fitness = Vec::with_capacity(networks.len());
+    let mut fitness = Vec::with_capacity(range.len());
     for piece in pieces {
         fitness.extend(piece?);
     }
@@ -392,6 +415,47 @@ mod tests {
             .install(|| evaluate_all(&CLEAN, &[] as &[Network], 5, &[]))
             .unwrap()
             .is_empty());
+    }
+
+    #[test]
+    fn a_range_gets_the_streams_and_bits_it_has_in_the_whole_set() {
+        let nets = networks(45);
+        let whole = evaluate_all(&CLEAN, &nets[..], 5, &[3, 9]).unwrap();
+        let one_by_one = FnEvaluator::new(1, 1, |n: &Network, rng: &mut Stream| CLEAN.evaluate(&mut (), n, rng));
+        for threads in [1, 3] {
+            for ranges in [vec![0..45], vec![0..7, 7..40, 40..45], vec![0..20, 20..20, 20..45]] {
+                for evaluator_is_batched in [true, false] {
+                    let pieces: Vec<f64> = ranges
+                        .iter()
+                        .flat_map(|range| {
+                            pool(threads)
+                                .install(|| match evaluator_is_batched {
+                                    true => evaluate_range(&CLEAN, &nets[..], 5, &[3, 9], range.clone()),
+                                    false => evaluate_range(&one_by_one, &nets[..], 5, &[3, 9], range.clone()),
+                                })
+                                .unwrap()
+                        })
+                        .collect();
+                    assert_eq!(
+                        pieces, whole,
+                        "{threads} threads, {ranges:?}, batched {evaluator_is_batched}"
+                    );
+                }
+            }
+        }
+        // An error names the network by its index in the whole set.
+        let failing = Batched {
+            fail_at: Some(33.0),
+            ..CLEAN
+        };
+        let error = evaluate_range(&failing, &nets[..], 1, &[], 30..40).unwrap_err();
+        assert!(format!("{error:#}").contains("gene 33 failed"), "{error:#}");
+        let nan = Batched {
+            nan_at: Some(31.0),
+            ..CLEAN
+        };
+        let error = evaluate_range(&nan, &nets[..], 1, &[], 30..40).unwrap_err();
+        assert!(error.to_string().contains("NaN for network 31"), "{error}");
     }
 
     #[test]

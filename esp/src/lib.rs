@@ -67,7 +67,7 @@ pub use any_run::AnyRun;
 pub use ask::{AskPurpose, AskTell, Asked, Ticket};
 pub use error::{RunError, SettingsError};
 pub use esp::{BurstMode, Credit, EraseAt, Esp, EspRun, EspSettings, Relesion, Sampling, StagnationRule, TopologyMode};
-pub use evaluator::{evaluate_all, evaluate_each, evaluate_each_part, Evaluator, FnEvaluator, Part};
+pub use evaluator::{evaluate_all, evaluate_each, evaluate_each_part, evaluate_range, Evaluator, FnEvaluator, Part};
 pub use hill_climb::{HillClimb, HillClimbRun, HillClimbSettings, MutationRates};
 pub use limits::{
     MAX_GENERATIONS, MAX_HIDDEN, MAX_NETWORKS_PER_GENERATION, MAX_NETWORK_SIDE, MAX_REAL_SETTING, MAX_SUBPOP_SIZE,

@@ -99,8 +99,15 @@ fn seeds(seed: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<u64>> {
 }
 
 /// How many batches a thread flies between two checks of Python's signals
-/// in `evaluate` (a fraction of a second at the paper's 500 steps).
+/// in `evaluate` and `Run.evaluate_psa` (a fraction of a second at the
+/// paper's 500 steps).
 const PIECE_BATCHES: usize = 64;
+
+/// How many networks `evaluator` flies on `pool` between two checks of
+/// Python's signals.
+pub(crate) fn piece_size(pool: &ThreadPool, evaluator: &PsaEvaluator) -> usize {
+    pool.current_num_threads().max(1) * evaluator.batch_size().max(1) * PIECE_BATCHES
+}
 
 /// Where a batch of networks goes: full batches of the evaluator's batch
 /// size, then what is left, each taken by whichever thread is free.
@@ -211,7 +218,7 @@ pub fn evaluate<'py>(
     // In pieces of many batches a thread, with Python's signals checked
     // between them: Ctrl-C stops a long call. Each network's bits do not
     // depend on the piece it is flown in.
-    let piece = pool.current_num_threads().max(1) * evaluator.batch_size().max(1) * PIECE_BATCHES;
+    let piece = piece_size(&pool, &evaluator);
     let mut fitness = Vec::with_capacity(networks.len());
     for start in (0..networks.len()).step_by(piece) {
         py.check_signals()?;

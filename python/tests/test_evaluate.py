@@ -3,6 +3,8 @@ by seed, and clear exceptions for bad input."""
 
 from __future__ import annotations
 
+import pathlib
+
 import numpy as np
 import pytest
 from conftest import random_networks
@@ -97,6 +99,15 @@ def test_a_config_file_is_a_dict(tmp_path, champions):
     assert 'input_sd = 0.05' in psa_esp.resolve_config(str(path))
 
 
+def test_a_model_by_name_is_the_file_under_configs_and_an_unknown_one_is_refused():
+    configs = pathlib.Path(__file__).resolve().parents[2] / "configs"
+    named = psa_esp.resolve_config({"model": "positive-wrap"})
+    assert named == psa_esp.resolve_config(str(configs / "positive-wrap.toml"))
+    assert 'heading_wrap = "positive"' in named and named != psa_esp.resolve_config()
+    with pytest.raises(ValueError, match="positive-wrap"):
+        psa_esp.resolve_config({"model": "positive"})
+
+
 def test_no_networks_is_no_fitness():
     assert psa_esp.evaluate(np.zeros((0, 5, 11)), 1).shape == (0,)
 
@@ -175,26 +186,35 @@ def test_a_large_call_flown_in_pieces_gives_each_network_its_own_bits():
     assert np.array_equal(whole, np.concatenate(parts))
 
 
-def test_ctrl_c_stops_a_long_evaluate_with_keyboard_interrupt():
+LONG_CALLS = {
+    # Ten million trials on one thread: minutes of work.
+    "evaluate": """
+        networks = np.random.default_rng(0).uniform(-3, 3, (100_000, 5, psa_esp.GENES_PER_NEURON))
+        started()
+        psa_esp.evaluate(networks, 1, trials=100, threads=1)
+        """,
+    # One generation of 20,000 networks of 100 trials each on one thread.
+    "Run.evaluate_psa": """
+        run = psa_esp.Run(seed=1, config={"esp": {"subpop_size": 2000}, "problem": {"trials": 100}})
+        asked = run.ask()
+        started()
+        run.evaluate_psa(asked, 1, threads=1)
+        """,
+}
+
+
+@pytest.mark.parametrize("call", sorted(LONG_CALLS))
+def test_ctrl_c_stops_a_long_evaluation_with_keyboard_interrupt(call):
     import signal
     import subprocess
     import sys
     import textwrap
     import time
 
-    # Ten million trials on one thread: minutes of work, stopped by SIGINT.
-    script = textwrap.dedent(
-        """
-        import numpy as np, psa_esp, sys
-        networks = np.random.default_rng(0).uniform(-3, 3, (100_000, 5, psa_esp.GENES_PER_NEURON))
-        try:
-            print("started", flush=True)
-            psa_esp.evaluate(networks, 1, trials=100, threads=1)
-            print("finished")
-        except KeyboardInterrupt:
-            print("interrupted")
-        """
-    )
+    script = "import numpy as np, psa_esp\n"
+    script += "def started():\n    print('started', flush=True)\n"
+    script += "try:\n" + textwrap.indent(textwrap.dedent(LONG_CALLS[call]), "    ")
+    script += "    print('finished')\nexcept KeyboardInterrupt:\n    print('interrupted')\n"
     child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert child.stdout.readline().strip() == "started"
     time.sleep(1)  # well inside the call, which runs for minutes
@@ -203,7 +223,7 @@ def test_ctrl_c_stops_a_long_evaluate_with_keyboard_interrupt():
         out, err = child.communicate(timeout=120)
     except subprocess.TimeoutExpired:
         child.kill()
-        raise AssertionError("evaluate did not stop on SIGINT") from None
+        raise AssertionError(f"{call} did not stop on SIGINT") from None
     assert out.strip() == "interrupted", err
 
 
