@@ -3,9 +3,10 @@
 //! `dWorldStep` per step for all of them.
 //!
 //! Every network runs the scalar path's trial loop ([`TrialRunner`] on
-//! `ode`; both fly `fly_steps` of [`super::flight`]), operation for
-//! operation, and ODE bodies built, pushed and read by the same functions; each body is an island of its own, which ODE steps
-//! from that body's state and forces alone. Each network draws its random
+//! `ode`; both fly `fly_steps` of `flight.rs`), operation for operation,
+//! and ODE bodies built, pushed and read by the same functions; each body
+//! is an island of its own, which ODE steps from that body's state and
+//! forces alone. Each network draws its random
 //! starts and noise seeds from its own stream in the scalar path's order
 //! (trial by trial: start, then noise seed). So its fitness is bit-identical
 //! to the scalar path's; a test holds them to that on every task, with
