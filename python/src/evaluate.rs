@@ -103,10 +103,30 @@ fn seeds(seed: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<u64>> {
 /// paper's 500 steps).
 const PIECE_BATCHES: usize = 64;
 
-/// How many networks `evaluator` flies on `pool` between two checks of
-/// Python's signals.
-pub(crate) fn piece_size(pool: &ThreadPool, evaluator: &PsaEvaluator) -> usize {
-    pool.current_num_threads().max(1) * evaluator.batch_size().max(1) * PIECE_BATCHES
+/// The fitness of networks `0..count`, flown by `fly(range)` on `pool`
+/// in pieces of many of `evaluator`'s batches a thread, the GIL released
+/// inside each and Python's signals checked between them: Ctrl-C stops a
+/// long call. Each network's bits do not depend on the piece it is flown
+/// in; `error` turns a piece's error into Python's.
+pub(crate) fn in_pieces<E>(
+    py: Python<'_>,
+    pool: &ThreadPool,
+    evaluator: &PsaEvaluator,
+    count: usize,
+    fly: impl Fn(Range<usize>) -> Result<Vec<f64>, E> + Sync,
+    error: impl Fn(E) -> PyErr,
+) -> PyResult<Vec<f64>>
+where
+    E: Send,
+{
+    let piece = pool.current_num_threads().max(1) * evaluator.batch_size().max(1) * PIECE_BATCHES;
+    let mut fitness = Vec::with_capacity(count);
+    for start in (0..count).step_by(piece) {
+        py.check_signals()?;
+        let range = start..(start + piece).min(count);
+        fitness.extend(py.detach(|| pool.install(|| fly(range))).map_err(&error)?);
+    }
+    Ok(fitness)
 }
 
 /// Where a batch of networks goes: full batches of the evaluator's batch
@@ -215,19 +235,14 @@ pub fn evaluate<'py>(
     let problem = problem(config, preset, backend, trials)?;
     let evaluator = PsaEvaluator::new(problem, task, &path).map_err(errors::config_chain)?;
     let pool = pool(threads)?;
-    // In pieces of many batches a thread, with Python's signals checked
-    // between them: Ctrl-C stops a long call. Each network's bits do not
-    // depend on the piece it is flown in.
-    let piece = piece_size(&pool, &evaluator);
-    let mut fitness = Vec::with_capacity(networks.len());
-    for start in (0..networks.len()).step_by(piece) {
-        py.check_signals()?;
-        let range = start..(start + piece).min(networks.len());
-        let piece = py
-            .detach(|| pool.install(|| evaluate_networks(&evaluator, &networks[range.clone()], &seeds[range.clone()])))
-            .map_err(errors::simulation)?;
-        fitness.extend(piece);
-    }
+    let fitness = in_pieces(
+        py,
+        &pool,
+        &evaluator,
+        networks.len(),
+        |range| evaluate_networks(&evaluator, &networks[range.clone()], &seeds[range]),
+        errors::simulation,
+    )?;
     let fitness = fitness.into_pyarray(py).into_any();
     if return_seed {
         Ok((fitness, seed).into_pyobject(py)?.into_any())

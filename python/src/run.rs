@@ -19,7 +19,7 @@ use pyo3::types::PyDict;
 
 use crate::args::{self, SeedArg};
 use crate::config::{run_config, type_name};
-use crate::evaluate::{eval_path, piece_size, pool, task_arg, DEFAULT_SEED};
+use crate::evaluate::{eval_path, in_pieces, pool, task_arg, DEFAULT_SEED};
 use crate::files::restorer;
 use crate::weights::{arrays_of, float_array, networks_from};
 use crate::{errors, records};
@@ -504,23 +504,16 @@ impl Run {
         )
         .map_err(errors::config_chain)?;
         let pool = pool(args::optional_count(threads, "threads")?)?;
-        // In pieces, with Python's signals checked between them (Ctrl-C
-        // stops a large generation); each network keeps its own stream.
+        // Each network keeps the stream it has in the whole generation.
         let networks = &asked.networks[..];
-        let piece = piece_size(&pool, &evaluator);
-        let mut fitness = Vec::with_capacity(networks.len());
-        for start in (0..networks.len()).step_by(piece) {
-            py.check_signals()?;
-            let range = start..(start + piece).min(networks.len());
-            let piece = py
-                .detach(|| {
-                    pool.install(|| {
-                        esp_neuroevolution::evaluate_range(&evaluator, networks, asked.seed, &asked.key, range)
-                    })
-                })
-                .map_err(errors::run)?;
-            fitness.extend(piece);
-        }
+        let fitness = in_pieces(
+            py,
+            &pool,
+            &evaluator,
+            networks.len(),
+            |range| esp_neuroevolution::evaluate_range(&evaluator, networks, asked.seed, &asked.key, range),
+            errors::run,
+        )?;
         Ok(PyArray1::from_vec(py, fitness))
     }
 
