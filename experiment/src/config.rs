@@ -65,9 +65,10 @@ impl Default for RunConfig {
 /// ESP's settings for the PSA, the paper's baseline (its Table 1):
 /// Høverstad's ESP with 5 sub-populations of 40 neurons at first, 10
 /// networks per neuron (400 a generation) and 2000 generations; the
-/// stagnation of 50 generations is fitted to the paper's burst totals
-/// (docs/sweeps/s05-stagnation-b.md, s16-s21-s23-heading-range.md and
-/// s28-stagnation-b-spreads.md).
+/// stagnation of 50 generations is chosen: D picked it from the paper's
+/// burst totals (docs/sweeps/s05-stagnation-b.md, s28-stagnation-b-spreads.md),
+/// and on today's model it is not told apart from 40 beyond seed noise
+/// (docs/model.md, "How sure the fit is").
 pub fn paper_esp_settings() -> EspSettings {
     EspSettings {
         subpop_size: 40,

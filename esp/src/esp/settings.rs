@@ -155,7 +155,7 @@ pub struct EspSettings {
     pub cauchy_limit: f64,
     /// Generations without improvement before a burst mutation (b).
     /// Default 20 (Gomez's code); Høverstad gives no number (the PSA's
-    /// fitted value is 50: psa-esp's docs/model.md). Bounds: at least 1.
+    /// chosen value is 50: psa-esp's docs/model.md). Bounds: at least 1.
     pub stagnation: usize,
     /// What "without improvement" means. Default phase_best (Gomez's code
     /// and Høverstad's §3.2).
