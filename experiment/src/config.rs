@@ -67,7 +67,7 @@ impl Default for RunConfig {
 /// networks per neuron (400 a generation) and 2000 generations; the
 /// stagnation of 50 generations is chosen: D picked it from the paper's
 /// burst totals (docs/sweeps/s05-stagnation-b.md, s28-stagnation-b-spreads.md),
-/// and on today's model it is not told apart from 40 beyond seed noise
+/// and with the heading in (-pi, pi] it is not told apart from 40 beyond seed noise
 /// (docs/model.md, "How sure the fit is").
 pub fn paper_esp_settings() -> EspSettings {
     EspSettings {
