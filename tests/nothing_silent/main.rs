@@ -26,7 +26,7 @@ use psa_experiment::grid::sweep::{parse_vary, SweepMode, SweepSpec, MAX_VARIANT_
 use psa_experiment::grid::{run_dir, GridPreset, GridSpec, RunKey};
 use psa_experiment::RunFiles;
 use psa_sim::physics::{BackendKind, StartQuaternion};
-use psa_sim::psa::settings::defaults::{Placement, BUILDS, CHANGES};
+use psa_sim::psa::settings::defaults::{Placement, CHANGES};
 use psa_sim::psa::{FitnessState, HeadingWrap, NetworkFile, PsaSettings, Scoring, Task};
 
 use common::psa_esp;
@@ -83,11 +83,10 @@ pub(crate) fn make_fifo(path: &Path) {
 /// The full hash of the parent of `commit` (a prefix), from the history
 /// the table of defaults places builds in.
 pub(crate) fn parent_of(commit: &str) -> String {
-    let line = BUILDS
-        .lines()
-        .find(|l| l.starts_with(commit))
-        .expect("a commit of the history");
-    line.split(' ').nth(1).expect("a parent").to_string()
+    match Placement::before_commit(commit) {
+        Some(Placement::Commit(parent)) => parent,
+        _ => panic!("{commit}: not a commit of the history with a parent"),
+    }
 }
 
 /// A process id that no process has now: a child that has ended.
