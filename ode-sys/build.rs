@@ -26,8 +26,12 @@ fn main() {
 
     let mut shim = cc::Build::new();
     shim.file("shim/ode_shim.c").warnings(true);
+    // ODE's include paths go after the compiler's own system headers, here
+    // and for bindgen: a build against another C library's headers (the
+    // portable wheel's, through zig) must not pick up this host's libc
+    // headers from pkg-config's /usr/include.
     for path in &ode.include_paths {
-        shim.include(path);
+        shim.flag("-idirafter").flag(path.display().to_string());
     }
     shim.compile("psa_ode_shim");
 
@@ -44,7 +48,7 @@ fn main() {
         .layout_tests(false)
         .parse_callbacks(Box::new(bindgen::CargoCallbacks::new()));
     for path in &ode.include_paths {
-        builder = builder.clang_arg(format!("-I{}", path.display()));
+        builder = builder.clang_args(["-idirafter".to_owned(), path.display().to_string()]);
     }
     for (name, value) in &ode.defines {
         builder = builder.clang_arg(match value {

@@ -26,9 +26,11 @@ the ``native`` backend (bit-identical to ``ode``, many times faster).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import gymnasium
 
-from . import errors
+from . import _native, errors
 from ._native import (
     GENES_PER_NEURON,
     INPUTS,
@@ -50,6 +52,13 @@ from ._native import (
 from .errors import *  # noqa: F401,F403
 
 TASKS = (1, 2, 3)
+
+# The portable wheel carries DejaVu Sans (python/build-wheel puts it here):
+# rendering then needs no font on the machine and draws the same text on
+# every one. A plain install has no copy and uses the system's.
+_PACKAGED_FONT = Path(__file__).with_name("fonts") / "DejaVuSans.ttf"
+if _PACKAGED_FONT.is_file():
+    _native._use_packaged_font(str(_PACKAGED_FONT))
 
 
 def evolve(

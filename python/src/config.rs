@@ -86,7 +86,7 @@ fn to_toml(value: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
         return Ok(toml::Value::Float(value.extract()?));
     }
     if let Ok(text) = value.cast::<PyString>() {
-        return Ok(toml::Value::String(text.to_str()?.to_owned()));
+        return Ok(toml::Value::String(text.to_cow()?.into_owned()));
     }
     if let Ok(dict) = value.cast::<PyDict>() {
         let mut table = toml::Table::new();

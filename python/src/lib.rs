@@ -40,6 +40,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::_run_from_json, m)?)?;
     m.add_function(wrap_pyfunction!(run::_asked_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(run::_ticket_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(trial::_use_packaged_font, m)?)?;
     m.add_class::<files::Network>()?;
     m.add_class::<run::Run>()?;
     m.add_class::<run::Asked>()?;

@@ -8,7 +8,7 @@ use std::f64::consts::{PI, TAU};
 
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray1, PyArray3, PyArrayMethods};
-use psa_experiment::plots::{ensure_font, trial_frame, TrialPicture, FIGURE_HEIGHT, FIGURE_WIDTH};
+use psa_experiment::plots::{ensure_font, trial_frame, use_packaged_font, TrialPicture, FIGURE_HEIGHT, FIGURE_WIDTH};
 use psa_sim::named::Named;
 use psa_sim::numeric::{clamp_unit, NoiseSource};
 use psa_sim::physics::{create_backend, BodyState, PlanarState};
@@ -385,4 +385,12 @@ impl Trial {
     fn inputs() -> usize {
         INPUT_COUNT
     }
+}
+
+/// Names the font the portable wheel carries (`psa_esp/fonts/`), tried for
+/// rendering after `PSA_ESP_FONT` and before the system's fonts; the
+/// package calls it on import when the file is there.
+#[pyfunction]
+pub fn _use_packaged_font(path: std::path::PathBuf) {
+    use_packaged_font(path);
 }

@@ -37,11 +37,23 @@ const FONT_CANDIDATES: &[&str] = &[
 
 static FONT: OnceLock<Result<PathBuf, String>> = OnceLock::new();
 
+static PACKAGED_FONT: OnceLock<PathBuf> = OnceLock::new();
+
+/// Names a font file shipped with the program (the Python wheel's copy of
+/// DejaVu Sans), tried by [`ensure_font`] after [`FONT_ENV_VAR`] and before
+/// the system's paths, so that a packaged program draws the same text on
+/// every machine. Only the first call counts, and only before the first
+/// [`ensure_font`].
+pub fn use_packaged_font(path: PathBuf) {
+    let _ = PACKAGED_FONT.set(path);
+}
+
 /// Loads a sans-serif TrueType font and registers it with plotters as
 /// [`FONT_FAMILY`]; later calls return the first call's outcome at once.
 ///
 /// The file named by the environment variable [`FONT_ENV_VAR`] is tried
-/// first, then the usual system locations (DejaVu Sans first). Returns the
+/// first, then a packaged font ([`use_packaged_font`]), then the usual
+/// system locations (DejaVu Sans first). Returns the
 /// path of the font in use, or an error that names the package to install
 /// ([`FONT_PACKAGE`] on Debian and Ubuntu).
 pub fn ensure_font() -> anyhow::Result<&'static Path> {
@@ -56,6 +68,7 @@ fn load_font() -> Result<PathBuf, String> {
     if let Some(path) = std::env::var_os(FONT_ENV_VAR) {
         candidates.push(PathBuf::from(path));
     }
+    candidates.extend(PACKAGED_FONT.get().cloned());
     candidates.extend(FONT_CANDIDATES.iter().map(PathBuf::from));
     let mut problems = Vec::new();
     for path in candidates {

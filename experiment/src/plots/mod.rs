@@ -18,6 +18,6 @@ mod output;
 pub mod picture;
 pub mod trial;
 
-pub use font::{ensure_font, FONT_ENV_VAR, FONT_FAMILY, FONT_PACKAGE};
+pub use font::{ensure_font, use_packaged_font, FONT_ENV_VAR, FONT_FAMILY, FONT_PACKAGE};
 pub use picture::TrialPicture;
 pub use trial::{trial_frame, write_trial_pictures, FIGURE_HEIGHT, FIGURE_WIDTH};
