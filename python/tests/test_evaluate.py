@@ -211,7 +211,10 @@ def test_ctrl_c_stops_a_long_evaluation_with_keyboard_interrupt(call):
     import textwrap
     import time
 
-    script = "import numpy as np, psa_esp\n"
+    # Python's own handler, whatever the child inherits: a shell starts
+    # background jobs with SIGINT ignored, and Python keeps that.
+    script = "import signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\n"
+    script += "import numpy as np, psa_esp\n"
     script += "def started():\n    print('started', flush=True)\n"
     script += "try:\n" + textwrap.indent(textwrap.dedent(LONG_CALLS[call]), "    ")
     script += "    print('finished')\nexcept KeyboardInterrupt:\n    print('interrupted')\n"
