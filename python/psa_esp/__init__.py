@@ -26,7 +26,7 @@ the ``native`` backend (bit-identical to ``ode``, many times faster).
 
 from __future__ import annotations
 
-from pathlib import Path
+from pathlib import Path as _Path
 
 import gymnasium
 
@@ -56,7 +56,7 @@ TASKS = (1, 2, 3)
 # The portable wheel carries DejaVu Sans (python/build-wheel puts it here):
 # rendering then needs no font on the machine and draws the same text on
 # every one. A plain install has no copy and uses the system's.
-_PACKAGED_FONT = Path(__file__).with_name("fonts") / "DejaVuSans.ttf"
+_PACKAGED_FONT = _Path(__file__).with_name("fonts") / "DejaVuSans.ttf"
 if _PACKAGED_FONT.is_file():
     _native._use_packaged_font(str(_PACKAGED_FONT))
 
