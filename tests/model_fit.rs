@@ -235,6 +235,25 @@ fn the_positive_wrap_file_repeats_the_records_of_the_confirmed_grid_byte_for_byt
 }
 
 #[test]
+fn the_heading_error_file_repeats_the_records_of_the_confirmed_grid_byte_for_byte() {
+    // Recorded by build a35a2bb, whose defaults the file pins: the heading
+    // input is the heading minus the target's.
+    let config = "configs/heading-error.toml";
+    assert_repeats_the_golden_records(config, "heading-error", &["baseline", "max-credit"]);
+    // Today's defaults read the heading itself. Tasks 1 and 3 aim at
+    // heading 0, where the two inputs are the same number: the same runs.
+    // Task 2 aims at pi/2: another run.
+    for (task, moves) in [("1", false), ("2", true), ("3", false)] {
+        let recorded = std::fs::read(repo(&format!("tests/golden/heading-error/baseline-t{task}.csv"))).unwrap();
+        assert_eq!(
+            golden_run_records(None, "baseline", task) != recorded,
+            moves,
+            "task {task}: the defaults moved or stayed against the heading error"
+        );
+    }
+}
+
+#[test]
 fn every_earlier_model_and_the_fits_starting_point_have_golden_records_and_nothing_else_has() {
     let mut folders: Vec<String> = std::fs::read_dir(repo("tests/golden"))
         .unwrap()
@@ -444,6 +463,8 @@ fn the_text_model_sets_exactly_the_settings_the_papers_words_decide_each_with_it
     // Noise on the bias too (`noise.on_bias`) is the text's reading and
     // the default: the file sets it, with its words, and changes nothing.
     assert!(text.contains("\non_bias = true\n"));
+    // So is the heading itself as the heading input (`heading_input`).
+    assert!(text.contains("\nheading_input = \"absolute\"\n"));
     assert_eq!(
         changed,
         [
@@ -451,7 +472,6 @@ fn the_text_model_sets_exactly_the_settings_the_papers_words_decide_each_with_it
             "problem.fitness.slowing",
             "problem.fitness.state",
             "problem.sensors.angular_velocity_scale",
-            "problem.sensors.heading_input",
             "problem.sensors.heading_scale",
             "problem.sensors.position_scale",
             "problem.sensors.velocity_scale",

@@ -44,6 +44,9 @@ pub enum EarlierModel {
     NoiselessBias,
     /// Before the heading input went back to (-pi, pi].
     PositiveWrap,
+    /// Before the heading input became the heading itself: the heading
+    /// error (the defaults confirmed by S50).
+    HeadingError,
 }
 
 impl Named for EarlierModel {
@@ -65,6 +68,7 @@ impl EarlierModel {
             ClockwiseStart => before_row("problem.tasks.task2_spin", "-0.75"),
             NoiselessBias => before_row("problem.noise.on_bias", "true"),
             PositiveWrap => before_row("problem.sensors.heading_wrap", r#""symmetric""#),
+            HeadingError => before_row("problem.sensors.heading_input", r#""absolute""#),
         }
     }
 

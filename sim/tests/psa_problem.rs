@@ -379,7 +379,7 @@ fn random_init_is_refused_for_task_2_and_bad_settings_name_themselves() {
 
 #[test]
 fn inputs_are_relative_to_the_target_scaled_and_wrapped() {
-    let s = SensorSettings::default();
+    let mut s = SensorSettings::default();
     let state = BodyState {
         x: 0.1,
         y: 0.5,
@@ -397,9 +397,13 @@ fn inputs_are_relative_to_the_target_scaled_and_wrapped() {
     // The defaults: 5 per m, 5 per m/s, 0.5 per rad and per rad/s.
     assert!((i[0] - 0.5).abs() < 1e-12 && (i[1] - 0.5).abs() < 1e-12);
     assert!((i[2] + 1.0).abs() < 1e-12 && (i[3] - 0.25).abs() < 1e-12);
-    // -3 - pi wraps to 2 pi - 3 - pi = pi - 3.
-    assert!((i[4] - 0.5 * (PI - 3.0)).abs() < 1e-12, "{}", i[4]);
+    // The heading itself: -3 lies in (-pi, pi].
+    assert_eq!(i[4], 0.5 * -3.0);
     assert_eq!((i[5], i[6]), (0.35, 1.0));
+    // The heading error: -3 - pi wraps to 2 pi - 3 - pi = pi - 3.
+    s.heading_input = psa_sim::psa::HeadingInput::Error;
+    let i = s.inputs(&state, &target);
+    assert!((i[4] - 0.5 * (PI - 3.0)).abs() < 1e-12, "{}", i[4]);
 }
 
 mod per_task {

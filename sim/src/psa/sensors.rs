@@ -16,11 +16,14 @@ pub const INPUT_COUNT: usize = 7;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum HeadingInput {
-    /// The heading minus the target heading. `[fitted]` default (D, S13 and S19)
-    #[default]
+    /// The heading minus the target heading: the default from sweep S13
+    /// to S50, fitted by D but not told apart from `Absolute` beyond seed
+    /// noise on seeds the fit never saw
+    /// (docs/sweeps/s50-confirmation-symmetric.md).
     Error,
-    /// The heading itself: the paper's input is "heading" (§2), and x and y
-    /// are relative to the target only in its fitness (§2.2).
+    /// The heading itself. `[chosen]` default, the text's reading: the
+    /// paper's input is "heading" (§2).
+    #[default]
     Absolute,
 }
 
@@ -87,7 +90,8 @@ pub struct SensorSettings {
     pub angular_velocity_scale: f64,
     /// The constant bias input. `[chosen]` 1
     pub bias: f64,
-    /// What the heading input measures. `[fitted]` error (D, S13 and S19)
+    /// What the heading input measures. `[chosen]` absolute, the text's
+    /// reading (docs/sweeps/s50-confirmation-symmetric.md)
     pub heading_input: HeadingInput,
     /// The range the heading input is wrapped to. `[chosen]` symmetric,
     /// (-pi, pi] (docs/sweeps/s49-task-settings-confirmation.md)
@@ -102,7 +106,7 @@ impl Default for SensorSettings {
             heading_scale: 0.5,
             angular_velocity_scale: 0.5,
             bias: 1.0,
-            heading_input: HeadingInput::Error,
+            heading_input: HeadingInput::default(),
             heading_wrap: HeadingWrap::default(),
         }
     }

@@ -156,6 +156,7 @@ mod tests {
         let mut s = Settings::default();
         s.sensors.heading_scale = 1.0;
         s.sensors.heading_wrap = HeadingWrap::Symmetric;
+        s.sensors.heading_input = HeadingInput::Error;
         let target = [0.0, 0.0, 1.0];
         // The error: heading -3 against target 1 is -4, wrapped to 2 pi - 4.
         assert_eq!(clean_reading(&s, -3.0, target).inputs[4], TAU - 4.0);

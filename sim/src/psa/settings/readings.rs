@@ -169,14 +169,14 @@ pub const READINGS: &[Reading] = &[
     Reading {
         key: "sensors.heading_input",
         doc: "the heading input: `error` (the heading minus the target's) or `absolute` (the heading itself)",
-        tag: Tag::Fitted,
+        tag: Tag::Chosen,
         define: Some(Define {
             name: "PSA_HEADING_ABSOLUTE",
             on: |s| s.sensors.heading_input == HeadingInput::Absolute,
         }),
         task_key: None,
         describe: Describe::Lines(describe_heading),
-        set_test_value: |s| s.sensors.heading_input = HeadingInput::Absolute,
+        set_test_value: |s| s.sensors.heading_input = HeadingInput::Error,
     },
     Reading {
         key: "sensors.heading_wrap",
