@@ -9,7 +9,7 @@ use super::task::Target;
 use crate::numeric::{Normals, Real};
 use crate::physics::{wrap_angle, BodyState};
 
-/// Number of network inputs: x, y, vx, vy, heading error, omega, bias.
+/// Number of network inputs: x, y, vx, vy, the heading input, omega, bias.
 pub const INPUT_COUNT: usize = 7;
 
 /// What the heading input measures.
@@ -84,7 +84,7 @@ pub struct SensorSettings {
     pub position_scale: f64,
     /// Input units per m/s of velocity. `[fitted]` 5
     pub velocity_scale: f64,
-    /// Input units per radian of heading error. `[fitted]` 0.5
+    /// Input units per radian of the heading input. `[fitted]` 0.5
     pub heading_scale: f64,
     /// Input units per rad/s of angular velocity. `[fitted]` 0.5
     pub angular_velocity_scale: f64,
