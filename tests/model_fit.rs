@@ -225,13 +225,7 @@ fn the_positive_wrap_file_repeats_the_records_of_the_confirmed_grid_byte_for_byt
     let config = "configs/positive-wrap.toml";
     assert_repeats_the_golden_records(config, "positive-wrap", &["baseline", "max-credit"]);
     // Today's defaults wrap it to (-pi, pi]: every task flies another run.
-    for task in ["1", "2", "3"] {
-        let recorded = std::fs::read(repo(&format!("tests/golden/positive-wrap/baseline-t{task}.csv"))).unwrap();
-        assert!(
-            golden_run_records(None, "baseline", task) != recorded,
-            "task {task}: the defaults did not move"
-        );
-    }
+    assert_the_defaults_move_on("positive-wrap", [true, true, true]);
 }
 
 #[test]
@@ -243,12 +237,19 @@ fn the_heading_error_file_repeats_the_records_of_the_confirmed_grid_byte_for_byt
     // Today's defaults read the heading itself. Tasks 1 and 3 aim at
     // heading 0, where the two inputs are the same number: the same runs.
     // Task 2 aims at pi/2: another run.
-    for (task, moves) in [("1", false), ("2", true), ("3", false)] {
-        let recorded = std::fs::read(repo(&format!("tests/golden/heading-error/baseline-t{task}.csv"))).unwrap();
+    assert_the_defaults_move_on("heading-error", [false, true, false]);
+}
+
+/// Asserts that today's defaults fly another baseline run than the one
+/// recorded in `tests/golden/GOLDEN/` on exactly the tasks (1 to 3) that
+/// `moves` marks, and the same run on the others.
+fn assert_the_defaults_move_on(golden: &str, moves: [bool; 3]) {
+    for (task, moves) in ["1", "2", "3"].into_iter().zip(moves) {
+        let recorded = std::fs::read(repo(&format!("tests/golden/{golden}/baseline-t{task}.csv"))).unwrap();
         assert_eq!(
             golden_run_records(None, "baseline", task) != recorded,
             moves,
-            "task {task}: the defaults moved or stayed against the heading error"
+            "task {task}: the defaults moved or stayed against tests/golden/{golden}"
         );
     }
 }

@@ -7,8 +7,8 @@
   the position relative to the target, vx and vy (the velocity), the
   heading input (the heading by default, or its error from the target;
   wrapped), omega (the spin) and the bias, each scaled as the model
-  scales it, with input noise where configured; the observation space bounds the heading input and the bias
-  where no noise reaches them;
+  scales it, with input noise where configured; the observation space
+  bounds the heading input and the bias where no noise reaches them;
 - the action is the four thrusters' commands (thrusters 0 to 3), each
   clamped to [0, 1] after the output noise, if any;
 - the reward is the step's increment of the evolution fitness, in % of

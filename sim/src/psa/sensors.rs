@@ -91,7 +91,7 @@ pub struct SensorSettings {
     /// The constant bias input. `[chosen]` 1
     pub bias: f64,
     /// What the heading input measures. `[chosen]` absolute, the text's
-    /// reading (docs/sweeps/s50-confirmation-symmetric.md)
+    /// reading (docs/sweeps/s51-heading-itself.md)
     pub heading_input: HeadingInput,
     /// The range the heading input is wrapped to. `[chosen]` symmetric,
     /// (-pi, pi] (docs/sweeps/s49-task-settings-confirmation.md)
