@@ -234,10 +234,20 @@ fn the_heading_error_file_repeats_the_records_of_the_confirmed_grid_byte_for_byt
     // input is the heading minus the target's.
     let config = "configs/heading-error.toml";
     assert_repeats_the_golden_records(config, "heading-error", &["baseline", "max-credit"]);
-    // Today's defaults read the heading itself. Tasks 1 and 3 aim at
-    // heading 0, where the two inputs are the same number: the same runs.
-    // Task 2 aims at pi/2: another run.
-    assert_the_defaults_move_on("heading-error", [false, true, false]);
+    // Today's defaults read the heading itself (tasks 1 and 3 aim at
+    // heading 0, where the two inputs are the same number; task 2 at pi/2),
+    // and since S52 at the text's scales: every task moves.
+    assert_the_defaults_move_on("heading-error", [true, true, true]);
+}
+
+#[test]
+fn the_halved_scales_file_repeats_the_records_of_the_full_grid_of_s51_byte_for_byte() {
+    // Recorded by build a3905c5, whose defaults the file pins: the sensor
+    // scales halved.
+    let config = "configs/halved-scales.toml";
+    assert_repeats_the_golden_records(config, "halved-scales", &["baseline", "max-credit"]);
+    // Today's defaults read the sensors at the text's scales: every task moves.
+    assert_the_defaults_move_on("halved-scales", [true, true, true]);
 }
 
 /// Asserts that today's defaults fly another baseline run than the one
@@ -464,18 +474,16 @@ fn the_text_model_sets_exactly_the_settings_the_papers_words_decide_each_with_it
     // Noise on the bias too (`noise.on_bias`) is the text's reading and
     // the default: the file sets it, with its words, and changes nothing.
     assert!(text.contains("\non_bias = true\n"));
-    // So is the heading itself as the heading input (`heading_input`).
+    // So is the heading itself as the heading input (`heading_input`),
+    // and so are the scales at k = 1.
     assert!(text.contains("\nheading_input = \"absolute\"\n"));
+    assert!(text.contains("\nposition_scale = 10.0\n"));
     assert_eq!(
         changed,
         [
             "problem.fitness.scoring",
             "problem.fitness.slowing",
             "problem.fitness.state",
-            "problem.sensors.angular_velocity_scale",
-            "problem.sensors.heading_scale",
-            "problem.sensors.position_scale",
-            "problem.sensors.velocity_scale",
             "problem.tasks.task2_spin",
         ]
     );

@@ -47,6 +47,9 @@ pub enum EarlierModel {
     /// Before the heading input became the heading itself: the heading
     /// error (the defaults confirmed by S50).
     HeadingError,
+    /// Before the sensor scales went back to the text's reading: the
+    /// scales halved (the defaults of the full grid of S51).
+    HalvedScales,
 }
 
 impl Named for EarlierModel {
@@ -69,6 +72,7 @@ impl EarlierModel {
             NoiselessBias => before_row("problem.noise.on_bias", "true"),
             PositiveWrap => before_row("problem.sensors.heading_wrap", r#""symmetric""#),
             HeadingError => before_row("problem.sensors.heading_input", r#""absolute""#),
+            HalvedScales => before_row("problem.sensors.position_scale", "10.0"),
         }
     }
 

@@ -394,16 +394,16 @@ fn inputs_are_relative_to_the_target_scaled_and_wrapped() {
         heading: PI,
     };
     let i = s.inputs(&state, &target);
-    // The defaults: 5 per m, 5 per m/s, 0.5 per rad and per rad/s.
-    assert!((i[0] - 0.5).abs() < 1e-12 && (i[1] - 0.5).abs() < 1e-12);
-    assert!((i[2] + 1.0).abs() < 1e-12 && (i[3] - 0.25).abs() < 1e-12);
+    // The defaults: 10 per m, 10 per m/s, 1 per rad and per rad/s.
+    assert!((i[0] - 1.0).abs() < 1e-12 && (i[1] - 1.0).abs() < 1e-12);
+    assert!((i[2] + 2.0).abs() < 1e-12 && (i[3] - 0.5).abs() < 1e-12);
     // The heading itself: -3 lies in (-pi, pi].
-    assert_eq!(i[4], 0.5 * -3.0);
-    assert_eq!((i[5], i[6]), (0.35, 1.0));
+    assert_eq!(i[4], -3.0);
+    assert_eq!((i[5], i[6]), (0.7, 1.0));
     // The heading error: -3 - pi wraps to 2 pi - 3 - pi = pi - 3.
     s.heading_input = psa_sim::psa::HeadingInput::Error;
     let i = s.inputs(&state, &target);
-    assert!((i[4] - 0.5 * (PI - 3.0)).abs() < 1e-12, "{}", i[4]);
+    assert!((i[4] - (PI - 3.0)).abs() < 1e-12, "{}", i[4]);
 }
 
 mod per_task {

@@ -19,7 +19,7 @@ fn a_report_says_above_its_tables_when_its_runs_flew_different_models() {
     let md = std::fs::read_to_string(grid.join("report.md")).unwrap();
     let banner = md.lines().find(|l| l.starts_with("**MIXED MODELS")).expect("a banner");
     assert!(
-        banner.contains("baseline task 1: `problem.sensors.position_scale` = 10.0 in 1 (seeds 2), 5.0 in 1 (seeds 1)"),
+        banner.contains("baseline task 1: `problem.noise.on_bias` = false in 1 (seeds 2), true in 1 (seeds 1)"),
         "{banner}"
     );
     assert!(md.find("**MIXED MODELS").unwrap() < md.find("## Grid").unwrap());
@@ -51,7 +51,7 @@ fn a_grid_of_an_earlier_build_is_reported_and_resuming_it_names_the_setting_and_
         &psa_esp(&tiny_args(&grid)),
         &[
             "esp.stagnation = 40 there",
-            "position_scale = 10.0 there",
+            "problem.noise.on_bias = false there",
             &parent_of("a70d696"),
         ],
     );

@@ -80,13 +80,19 @@ pub enum NoiseStage {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSettings {
-    /// Input units per metre of position relative to the target. `[fitted]` 5
+    /// Input units per metre of position relative to the target.
+    /// `[chosen]` 10, the text's reading: the input noise (sd 0.05) "about
+    /// two orders of magnitude less than the sensory input levels" (§5.1).
+    /// The halved scales fitted by D were not told apart from it on fresh
+    /// seeds (docs/sweeps/s52-scales-back-to-the-text.md)
     pub position_scale: f64,
-    /// Input units per m/s of velocity. `[fitted]` 5
+    /// Input units per m/s of velocity. `[chosen]` 10, as `position_scale`
     pub velocity_scale: f64,
-    /// Input units per radian of the heading input. `[fitted]` 0.5
+    /// Input units per radian of the heading input. `[chosen]` 1, as
+    /// `position_scale`
     pub heading_scale: f64,
-    /// Input units per rad/s of angular velocity. `[fitted]` 0.5
+    /// Input units per rad/s of angular velocity. `[chosen]` 1, as
+    /// `position_scale`
     pub angular_velocity_scale: f64,
     /// The constant bias input. `[chosen]` 1
     pub bias: f64,
@@ -101,10 +107,10 @@ pub struct SensorSettings {
 impl Default for SensorSettings {
     fn default() -> Self {
         SensorSettings {
-            position_scale: 5.0,
-            velocity_scale: 5.0,
-            heading_scale: 0.5,
-            angular_velocity_scale: 0.5,
+            position_scale: 10.0,
+            velocity_scale: 10.0,
+            heading_scale: 1.0,
+            angular_velocity_scale: 1.0,
             bias: 1.0,
             heading_input: HeadingInput::default(),
             heading_wrap: HeadingWrap::default(),

@@ -120,6 +120,10 @@ pub const CHANGES: &[Change] = &[
     changed("problem.noise.on_bias", "", "true"),
     changed("problem.sensors.heading_wrap", "", r#""symmetric""#),
     changed("problem.sensors.heading_input", "", r#""absolute""#),
+    changed("problem.sensors.position_scale", "", "10.0"),
+    changed("problem.sensors.velocity_scale", "", "10.0"),
+    changed("problem.sensors.heading_scale", "", "1.0"),
+    changed("problem.sensors.angular_velocity_scale", "", "1.0"),
 ];
 
 /// How many rows this build's table has: recorded in every file it writes.
