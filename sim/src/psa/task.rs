@@ -139,8 +139,11 @@ pub struct TaskSettings {
     /// turning when the trial starts. `[fitted]` -0.75, clockwise, away
     /// from the target: the whole distance to the paper (Table 1 and 2 for
     /// task 2 with their spreads, the burst totals and their ratio), fitted
-    /// with the sensor scales (docs/sweeps/s41-s44-one-factor-and-task2-start.md;
-    /// no source gives task 2's start)
+    /// with the halved sensor scales (docs/sweeps/s41-s44-one-factor-and-task2-start.md;
+    /// no source gives task 2's start). The scales went back to the text's
+    /// since; at them the start is not confirmed: at rest is not told apart
+    /// on fresh seeds, but §5.1's 1-point task-2 champion rules rest out
+    /// (docs/sweeps/s52-scales-back-to-the-text.md)
     pub task2_spin: f64,
     /// Task 2: initial velocity (vx, vy) in the world frame (m/s). `[chosen]` (0, 0)
     pub task2_velocity: [f64; 2],
