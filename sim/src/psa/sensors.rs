@@ -69,14 +69,14 @@ pub enum NoiseStage {
     Raw,
 }
 
-/// Input scaling: one factor, `[fitted]` 0.5, on the scales 10 per m, 10
-/// per m/s, 1 per rad and 1 per rad/s (docs/sweeps/s04-sensor-scaling.md,
-/// s39-sensor-scales.md, s41-s44-one-factor-and-task2-start.md); the
-/// inputs then lie about 0.75 to 2 (the box's 0.2 m, 0.4 m/s, a heading
-/// error of up to pi, 1.5 rad/s), 15 to 40 times the noise (sd 0.05).
-/// The text's "about two orders of magnitude" (§5.1) reads as factor 1
-/// (30 to 80 times): the fit, with task 2's start, moved away from it
-/// (configs/text.toml; docs/model.md, "How sure the fit is").
+/// Input scaling: `[chosen]` 10 per m, 10 per m/s, 1 per rad and 1 per
+/// rad/s, the text's reading of §5.1's noise (sd 0.05) "about two orders
+/// of magnitude less than the sensory input levels": the inputs then lie
+/// about 1.5 to 4 (the box's 0.2 m, 0.4 m/s, a heading of up to pi,
+/// 1.5 rad/s), 30 to 80 times the noise. D had halved them
+/// (docs/sweeps/s41-s44-one-factor-and-task2-start.md); on fresh seeds the
+/// halved scales were not told apart from these
+/// (docs/sweeps/s52-scales-back-to-the-text.md; configs/halved-scales.toml).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorSettings {

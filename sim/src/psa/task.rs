@@ -129,9 +129,11 @@ pub struct Target {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TaskSettings {
-    /// Task 1: initial spin (rad/s). `[fitted]` 1.0: the paper's Table 1
-    /// and 2 levels for task 1 with champions scored on the original
-    /// fitness (docs/sweeps/s10-task1-spin.md, s14-s15-starts-original-scoring.md)
+    /// Task 1: initial spin (rad/s). `[chosen]` 1.0: fitted by D on the
+    /// paper's Table 1 and 2 levels for task 1 (docs/sweeps/s10-task1-spin.md,
+    /// s14-s15-starts-original-scoring.md), but at the text's sensor scales
+    /// not told apart from 2.0 rad/s on fresh seeds; the text gives no spin
+    /// and neither is simpler, so 1.0 stays (docs/sweeps/s53-full-grid-at-the-texts-scales.md)
     pub task1_spin: f64,
     /// Task 2: target heading (rad, anticlockwise). `[chosen]` pi/2
     pub task2_target_heading: f64,
